@@ -1,0 +1,1 @@
+"""The scenes: one module per case, each registering itself in `lawbench.case.CASES`."""

@@ -1,0 +1,87 @@
+"""A chain of n balls on a line, all touching, optionally against a wall on the right.
+
+Generalized coordinates: the velocities v1 ... vn of the balls, left to right (m/s, positive to
+the right). Contact i (0-based) is between balls i+1 and i+2, gap rate ``v[i+1] - v[i]``; with
+``wall`` true, the last contact is between ball n and a fixed wall on its right, gap rate
+``-vn``. Every contact has stiffness 1 N/m^exponent. ``velocities`` gives the first balls; the
+ones it leaves out are at rest, so the default is one ball striking a chain at rest (the
+Newton's cradle of the textbooks). Source: Brogliato, *An introduction to impact dynamics*
+(2010), chains of balls.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from lawbench.case import CASES, Case, Params, Requirements, per_item
+from lawbench.chains import (
+    NEWTONS_CRADLE,
+    PLASTIC_CHAIN,
+    ball_velocities,
+    chain_problem,
+    exponent_spec,
+    gaps_spec,
+    masses_spec,
+    restitution_spec,
+    velocities_spec,
+)
+from lawbench.errors import InvalidProblem
+from lawbench.problem import ImpactProblem
+from lawbench.spec import Spec
+
+
+class BallChain(Case):
+    """n balls on a line, touching, struck from the left by default."""
+
+    name = "ball_chain"
+    summary = "n balls on a line, touching, optionally against a wall on the right"
+    params = (
+        Spec("n", 5, "number of balls", "", "int", 2, 100_000),
+        masses_spec([1.0]),
+        velocities_spec([1.0], "pre-impact velocities of the first balls; the rest are at rest"),
+        restitution_spec(),
+        Spec("wall", False, "a fixed wall right of the last ball, as the last contact", "", "bool"),
+        exponent_spec(),
+        gaps_spec(1),
+    )
+    requires = Requirements(several_contacts=True)
+    references = (PLASTIC_CHAIN, NEWTONS_CRADLE)
+
+    def _check(self, params: dict[str, Any]) -> None:
+        n = params["n"]
+        contacts = n if params["wall"] else n - 1
+        per_item(params, "masses", n, "ball")
+        velocities = params["velocities"]
+        if len(velocities) > n:
+            raise InvalidProblem(f"velocities has {len(velocities)} values, more than n = {n}")
+        params["velocities"] = velocities + [0.0] * (n - len(velocities))
+        per_item(params, "e", contacts, "contact")
+        per_item(params, "gaps", contacts, "contact")
+
+    def _build(self, params: dict[str, Any]) -> ImpactProblem:
+        n = params["n"]
+        pairs: list[tuple[int | None, int | None]] = [(i, i + 1) for i in range(n - 1)]
+        if params["wall"]:
+            pairs.append((n - 1, None))
+        return chain_problem(
+            params["masses"],
+            params["velocities"],
+            pairs=pairs,
+            restitution=params["e"],
+            stiffness=[1.0] * len(pairs),
+            exponent=params["exponent"],
+            gaps=params["gaps"],
+        )
+
+    def coordinates(self, params: Params) -> list[str]:
+        """Velocities of the n balls."""
+        return ball_velocities(params["n"])
+
+    def momentum_axes(self, params: Params) -> np.ndarray | None:
+        """Total momentum is conserved unless a wall takes part."""
+        return None if params["wall"] else np.ones((1, params["n"]))
+
+
+CASES.register(BallChain())

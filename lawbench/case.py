@@ -1,0 +1,152 @@
+"""The case protocol: a named scene with documented parameters and references.
+
+A case subclasses `Case`, declares its parameters as `Spec` objects, what it requires of a law,
+its analytic or published references, and implements `Case._build`, which receives every
+parameter checked and with defaults filled in and returns an `ImpactProblem`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from lawbench.errors import InvalidProblem
+from lawbench.law import Capabilities
+from lawbench.problem import ImpactProblem
+from lawbench.registry import Registry
+from lawbench.spec import Spec
+
+Params = Mapping[str, Any]
+
+
+@dataclass(frozen=True)
+class Requirements:
+    """What a scene needs of a law (friction, several contacts, spatial, stiffness)."""
+
+    friction: bool = False
+    several_contacts: bool = False
+    spatial: bool = False
+    stiffness: bool = False
+
+    def met_by(self, capabilities: Capabilities) -> bool:
+        """Whether a law with ``capabilities`` can treat the scene."""
+        return (
+            (capabilities.friction or not self.friction)
+            and (capabilities.several_contacts or not self.several_contacts)
+            and (capabilities.spatial or not self.spatial)
+        )
+
+
+def _always(params: Params) -> str | None:
+    return None
+
+
+@dataclass(frozen=True)
+class Reference:
+    """An analytic or published post-impact velocity for one law on a case.
+
+    Attributes
+    ----------
+    name : str
+        Short name, for tables.
+    source : str
+        Where it comes from (paper or book, equation).
+    law : str
+        The law it describes.
+    v_plus : callable
+        Complete parameters -> expected post-impact velocity.
+    options : mapping
+        Law options it assumes (for example a sequential ordering).
+    condition : callable
+        Complete parameters -> None when the reference holds, else why it does not.
+    """
+
+    name: str
+    source: str
+    law: str
+    v_plus: Callable[[Params], np.ndarray]
+    options: Mapping[str, Any] = field(default_factory=dict)
+    condition: Callable[[Params], str | None] = _always
+
+    def applies(self, law: str, options: Params, params: Params) -> str | None:
+        """None when this reference describes ``law`` with ``options`` at ``params``."""
+        if law != self.law:
+            return f"describes {self.law}"
+        for key, value in self.options.items():
+            if options.get(key) != value:
+                return f"assumes {key}={value}"
+        return self.condition(params)
+
+
+class Case(ABC):
+    """Base class of the scenes."""
+
+    name: ClassVar[str]
+    summary: ClassVar[str]
+    params: ClassVar[tuple[Spec, ...]]
+    requires: ClassVar[Requirements] = Requirements()
+    references: ClassVar[tuple[Reference, ...]] = ()
+
+    def parameters(self, **given: Any) -> dict[str, Any]:
+        """Every parameter, defaults filled in, checked and converted.
+
+        Raises
+        ------
+        InvalidProblem
+            For an unknown name or a bad value; the message names the parameter.
+        """
+        specs = {spec.name: spec for spec in self.params}
+        unknown = sorted(set(given) - set(specs))
+        if unknown:
+            raise InvalidProblem(
+                f"unknown parameter {unknown[0]!r} for case {self.name!r}; "
+                f"known: {', '.join(specs)}"
+            )
+        values = {name: spec.coerce(given.get(name, spec.default)) for name, spec in specs.items()}
+        self._check(values)
+        return values
+
+    def build(self, **given: Any) -> ImpactProblem:
+        """Build the impact problem of this scene at the given parameters."""
+        return self._build(self.parameters(**given))
+
+    def _check(self, params: dict[str, Any]) -> None:
+        """Check relations between parameters (list lengths); raise `InvalidProblem`."""
+
+    @abstractmethod
+    def _build(self, params: dict[str, Any]) -> ImpactProblem:
+        """Build the problem from complete, checked parameters."""
+
+    @abstractmethod
+    def coordinates(self, params: Params) -> list[str]:
+        """Names of the generalized velocities, in order, with units."""
+
+    def momentum_axes(self, params: Params) -> np.ndarray | None:
+        """Generalized directions (k, n) along which the impact conserves momentum, or None."""
+        return None
+
+
+def per_item(params: dict[str, Any], name: str, count: int, what: str) -> None:
+    """Expand ``params[name]`` to ``count`` entries: one value serves all; else count must match."""
+    values = params[name]
+    if len(values) == 1:
+        params[name] = values * count
+    elif len(values) != count:
+        raise InvalidProblem(
+            f"{name} has {len(values)} values, expected 1 or {count} (one per {what})"
+        )
+
+
+def exactly(params: Params, name: str, count: int, what: str) -> None:
+    """Raise `InvalidProblem` unless ``params[name]`` has ``count`` entries."""
+    if len(params[name]) != count:
+        raise InvalidProblem(
+            f"{name} has {len(params[name])} values, expected {count} (one per {what})"
+        )
+
+
+CASES: Registry[Case] = Registry("case", "lawbench.cases")

@@ -1,0 +1,168 @@
+"""Balls on a line: the impact problem of a chain, shared by the chain scenes.
+
+Coordinates are the ball velocities along the line. A contact is a pair ``(left, right)`` of
+ball indices, the right ball being on the positive side of the left one, so the gap rate is
+``v[right] - v[left]``; ``None`` in place of a ball is a fixed wall.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from lawbench.case import Reference
+from lawbench.problem import Contact, ImpactProblem
+from lawbench.spec import Spec
+
+Pair = tuple[int | None, int | None]
+
+
+def chain_problem(
+    masses: Sequence[float],
+    velocities: Sequence[float],
+    pairs: Sequence[Pair],
+    restitution: Sequence[float],
+    stiffness: Sequence[float],
+    exponent: float,
+    gaps: Sequence[float] | None = None,
+) -> ImpactProblem:
+    """Return the impact problem of balls on a line touching along ``pairs``.
+
+    Parameters
+    ----------
+    masses, velocities : sequences of n floats
+        Ball masses (kg) and velocities (m/s, positive to the right).
+    pairs : sequence of m (left, right) pairs
+        Ball indices, or None for a fixed wall on that side.
+    restitution, stiffness : sequences of m floats
+        Restitution coefficient and stiffness of each contact.
+    exponent : float
+        Force-indentation exponent of every contact.
+    gaps : sequence of m floats, optional
+        Initial gaps (m); zero by default.
+    """
+    n = len(masses)
+    Wn = np.zeros((n, len(pairs)))
+    for j, (left, right) in enumerate(pairs):
+        if left is not None:
+            Wn[left, j] = -1.0
+        if right is not None:
+            Wn[right, j] = 1.0
+    contacts = [
+        Contact(e=e, stiffness=k, exponent=exponent)
+        for e, k in zip(restitution, stiffness, strict=True)
+    ]
+    return ImpactProblem(
+        M=np.diag(np.asarray(masses, dtype=float)),
+        Wn=Wn,
+        v=np.asarray(velocities, dtype=float),
+        contacts=contacts,
+        bodies={f"ball {i + 1}": (i,) for i in range(n)},
+        gaps=None if gaps is None else np.asarray(gaps, dtype=float),
+    )
+
+
+def ball_velocities(n: int) -> list[str]:
+    """Coordinate names of n balls."""
+    return [f"v{i + 1} [m/s]" for i in range(n)]
+
+
+def masses_spec(default: list[float]) -> Spec:
+    """The ``masses`` parameter of a chain scene."""
+    return Spec("masses", default, "ball masses, left to right", "kg", "floats", 0.0, low_open=True)
+
+
+def velocities_spec(default: list[float], doc: str) -> Spec:
+    """The ``velocities`` parameter of a chain scene (pre-impact ball velocities)."""
+    return Spec("velocities", default, doc, "m/s", "floats")
+
+
+def restitution_spec() -> Spec:
+    """The ``e`` parameter: one restitution coefficient for all contacts, or one per contact."""
+    return Spec(
+        "e", [1.0], "restitution coefficient, one value or one per contact", "", "floats", 0.0, 1.0
+    )
+
+
+def exponent_spec() -> Spec:
+    """The ``exponent`` parameter: force-indentation exponent of the contacts."""
+    return Spec(
+        "exponent",
+        1.5,
+        "force-indentation exponent (1 linear, 1.5 Hertz)",
+        "",
+        "float",
+        0.0,
+        low_open=True,
+    )
+
+
+def stiffness_ratio_spec(doc: str) -> Spec:
+    """The ``stiffness_ratio`` parameter (contact 0 has stiffness 1 N/m^exponent)."""
+    return Spec("stiffness_ratio", 1.0, doc, "", "float", 0.0, low_open=True)
+
+
+def gaps_spec(count: int) -> Spec:
+    """The ``gaps`` parameter: initial gap of each contact, zero by default."""
+    return Spec(
+        "gaps", [0.0] * count, "initial gap of each contact (0: in contact)", "m", "floats", 0.0
+    )
+
+
+def _plastic_velocity(params: Mapping[str, Any]) -> np.ndarray:
+    wall = params.get("wall", False)
+    masses = np.asarray(params["masses"])
+    velocities = np.asarray(params["velocities"])
+    common = 0.0 if wall else float(masses @ velocities / masses.sum())
+    return np.full(len(masses), common)
+
+
+def _plastic_condition(params: Mapping[str, Any]) -> str | None:
+    if any(params["e"]):
+        return "needs e = 0 at every contact"
+    masses = np.asarray(params["masses"])
+    velocities = np.asarray(params["velocities"])
+    # Impulse of the contact right of ball j = momentum the balls 1..j lose.
+    impulses = np.cumsum(masses * (velocities - _plastic_velocity(params)))[:-1]
+    if params.get("wall", False):
+        impulses = np.append(impulses, masses @ velocities)
+    if (impulses < 0).any():
+        return "a contact would need a tensile impulse for the chain to stick"
+    return None
+
+
+# Brogliato, *An introduction to impact dynamics* (2010), remark after equation (29): with
+# e = 0 Moreau's law gives every ball the velocity of the centre of mass (zero against a wall
+# on the right). It holds while every contact impulse of the stuck chain is non-negative.
+PLASTIC_CHAIN = Reference(
+    name="plastic chain",
+    source="Brogliato 2010, remark after eq. (29): Moreau's law at e = 0",
+    law="moreau",
+    v_plus=_plastic_velocity,
+    condition=_plastic_condition,
+)
+
+
+def _cradle_condition(params: Mapping[str, Any]) -> str | None:
+    masses, velocities = params["masses"], params["velocities"]
+    if params.get("wall", False):
+        return "needs a free chain (no wall)"
+    if len(set(masses)) > 1:
+        return "needs equal masses"
+    if any(e != 1.0 for e in params["e"]):
+        return "needs e = 1"
+    if velocities[0] <= 0 or any(velocities[1:]):
+        return "needs the first ball moving right and the others at rest"
+    return None
+
+
+NEWTONS_CRADLE = Reference(
+    name="Newton's cradle",
+    source="textbook solution (Brogliato 2010, 'Textbooks solutions'): the last ball leaves "
+    "with the velocity of the first, the others stay at rest",
+    law="sequential",
+    v_plus=lambda p: np.eye(len(p["masses"]))[-1] * p["velocities"][0],
+    condition=_cradle_condition,
+)

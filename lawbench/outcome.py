@@ -1,0 +1,82 @@
+"""The result every law returns, with the same fields for all of them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from lawbench.mechanics import kinetic_energy, velocity_after
+from lawbench.problem import ImpactProblem
+
+
+@dataclass(frozen=True, eq=False)
+class Outcome:
+    """Post-impact state of an impact problem.
+
+    Attributes
+    ----------
+    v_plus : array (n,)
+        Post-impact generalized velocity.
+    Pn : array (m,)
+        Normal impulse of every contact (>= 0 pushes apart).
+    Pt : array (m*d,)
+        Tangential impulses; empty without friction.
+    T_minus, T_plus : float
+        Kinetic energy before and after.
+    status : str
+        'ok', or a word a law uses to flag a questionable answer (for example 'ambiguous').
+    diagnostics : dict
+        Formulation used, iterations or steps, solver status, wall time (``wall_time_s``).
+    path : dict or None
+        On request, quantities along the impact variable, for plots.
+    """
+
+    v_plus: np.ndarray
+    Pn: np.ndarray
+    Pt: np.ndarray
+    T_minus: float
+    T_plus: float
+    status: str = "ok"
+    diagnostics: dict[str, Any] = field(default_factory=dict)
+    path: dict[str, np.ndarray] | None = None
+
+    @property
+    def dT(self) -> float:
+        """Kinetic energy change ``T_plus - T_minus`` (positive: energy created)."""
+        return self.T_plus - self.T_minus
+
+    @classmethod
+    def from_impulses(
+        cls, problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None, **fields: Any
+    ) -> Outcome:
+        """Build the outcome of applying impulses ``Pn`` (and ``Pt``) to ``problem``.
+
+        ``fields`` are the optional fields (status, diagnostics, path).
+        """
+        return cls.from_velocity(problem, velocity_after(problem, Pn, Pt), Pn, Pt, **fields)
+
+    @classmethod
+    def from_velocity(
+        cls,
+        problem: ImpactProblem,
+        v_plus: np.ndarray,
+        Pn: np.ndarray,
+        Pt: np.ndarray | None = None,
+        *,
+        status: str = "ok",
+        diagnostics: dict[str, Any] | None = None,
+        path: dict[str, np.ndarray] | None = None,
+    ) -> Outcome:
+        """Build an outcome from a post-impact velocity a law computed itself."""
+        return cls(
+            v_plus=np.asarray(v_plus, dtype=float),
+            Pn=np.asarray(Pn, dtype=float),
+            Pt=np.zeros(0) if Pt is None else np.asarray(Pt, dtype=float),
+            T_minus=kinetic_energy(problem.M, problem.v),
+            T_plus=kinetic_energy(problem.M, v_plus),
+            status=status,
+            diagnostics=dict(diagnostics or {}),
+            path=path,
+        )

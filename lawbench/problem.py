@@ -1,0 +1,247 @@
+"""The impact problem every law consumes: linear algebra at a frozen configuration.
+
+Sign conventions, used everywhere in lawbench: the gap rate of contact j is
+``un[j] = Wn[:, j] @ v``; ``un < 0`` approaches and ``un > 0`` separates. Normal impulses
+``Pn >= 0`` push the bodies apart, and ``v_plus = v + M^-1 (Wn @ Pn + Wt @ Pt)``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg
+
+from lawbench.errors import InvalidProblem
+
+RESTITUTION_KINDS = ("newton", "poisson", "energy")
+
+
+def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
+    """Raise `InvalidProblem` unless ``low <= value <= high`` (``high`` None: unbounded)."""
+    if not math.isfinite(value):
+        raise InvalidProblem(f"{label} = {value}: must be a finite number")
+    if value < low or (high is not None and value > high):
+        bounds = f"in [{low:g}, {high:g}]" if high is not None else f">= {low:g}"
+        raise InvalidProblem(f"{label} = {value:g}: must be {bounds}")
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Parameters of one contact.
+
+    Parameters
+    ----------
+    e : float
+        Restitution coefficient, read by each law as its own kind: kinematic for Newton and
+        Moreau, kinetic for Poisson, energetic (Stronge) for Darboux-Keller and the energetic
+        multiple-impact law. In [0, 1].
+    e_newton, e_poisson, e_energy : float or None
+        Overrides of ``e`` for one kind of coefficient.
+    e_t : float
+        Tangential restitution coefficient (Brach), in [-1, 1].
+    mu : float
+        Coulomb friction coefficient; 0 means frictionless.
+    stiffness : float
+        Contact stiffness (N/m^exponent); compliant models use it, rigid laws only its ratios.
+    exponent : float
+        Force-indentation exponent: 1 linear, 1.5 Hertz.
+    damping : float
+        Damping coefficient of compliant models.
+    tangential_stiffness_ratio : float or None
+        Jia's ratio eta0^2 of tangential to normal stiffness.
+    """
+
+    e: float = 1.0
+    e_newton: float | None = None
+    e_poisson: float | None = None
+    e_energy: float | None = None
+    e_t: float = 0.0
+    mu: float = 0.0
+    stiffness: float = 1.0
+    exponent: float = 1.5
+    damping: float = 0.0
+    tangential_stiffness_ratio: float | None = None
+
+    def validate(self, label: str) -> None:
+        """Raise `InvalidProblem` naming ``label.field`` for the first bad field."""
+        for name in ("e", "e_newton", "e_poisson", "e_energy"):
+            value = getattr(self, name)
+            if value is not None:
+                _check_range(f"{label}.{name}", value, 0.0, 1.0)
+        _check_range(f"{label}.e_t", self.e_t, -1.0, 1.0)
+        _check_range(f"{label}.mu", self.mu, 0.0)
+        _check_range(f"{label}.damping", self.damping, 0.0)
+        for name in ("stiffness", "exponent", "tangential_stiffness_ratio"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            _check_range(f"{label}.{name}", value, 0.0)
+            if value == 0.0:
+                raise InvalidProblem(f"{label}.{name} = 0: must be > 0")
+
+    def restitution(self, kind: str) -> float:
+        """Return the coefficient of ``kind`` ('newton', 'poisson' or 'energy')."""
+        if kind not in RESTITUTION_KINDS:
+            raise ValueError(f"unknown restitution kind {kind!r}")
+        override = getattr(self, f"e_{kind}")
+        return self.e if override is None else override
+
+
+def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
+    """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`."""
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
+    if array.shape != shape:
+        raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
+    bad = np.argwhere(~np.isfinite(array))
+    if bad.size:
+        index = tuple(int(i) for i in bad[0])
+        raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
+    array.flags.writeable = False
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class ImpactProblem:
+    """An impact at a frozen configuration, validated when built.
+
+    Parameters
+    ----------
+    M : array (n, n)
+        Symmetric positive definite mass matrix in generalized coordinates.
+    Wn : array (n, m)
+        Normal Jacobian: ``un = Wn.T @ v`` is the gap rate of the m contacts.
+    v : array (n,)
+        Pre-impact generalized velocity.
+    contacts : sequence of Contact
+        One entry per contact.
+    Wt : array (n, m*d) or None
+        Tangential Jacobian, d = 1 (planar) or 2 (spatial); None without friction.
+    bodies : mapping of str to sequence of int
+        Body name -> indices of its generalized coordinates (for energy shares).
+    gaps : array (m,) or None
+        Initial gaps; None means zero (a simultaneous impact). A contact with a positive gap is
+        open: the rigid laws leave it alone at this instant.
+
+    Raises
+    ------
+    InvalidProblem
+        When a shape disagrees, M is not symmetric positive definite, a number is not finite,
+        or a contact parameter is out of range; the message names the field and value.
+    """
+
+    M: np.ndarray
+    Wn: np.ndarray
+    v: np.ndarray
+    contacts: Sequence[Contact]
+    Wt: np.ndarray | None = None
+    bodies: Mapping[str, Sequence[int]] = field(default_factory=dict)
+    gaps: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        v = np.array(self.v, dtype=float, ndmin=1)
+        n = v.shape[0] if v.ndim == 1 else -1
+        if n < 1:
+            raise InvalidProblem(f"v has shape {v.shape}, expected (n,) with n >= 1")
+        contacts = tuple(self.contacts)
+        m = len(contacts)
+        if m < 1:
+            raise InvalidProblem("contacts is empty: an impact needs at least one contact")
+        for j, contact in enumerate(contacts):
+            if not isinstance(contact, Contact):
+                raise InvalidProblem(f"contacts[{j}] is {type(contact).__name__}, not Contact")
+            contact.validate(f"contacts[{j}]")
+        set_ = object.__setattr__
+        set_(self, "v", _matrix("v", v, (n,)))
+        set_(self, "M", _matrix("M", self.M, (n, n)))
+        set_(self, "Wn", _matrix("Wn", self.Wn, (n, m)))
+        set_(self, "contacts", contacts)
+        if self.Wt is not None:
+            d = np.shape(self.Wt)[1] // m if np.ndim(self.Wt) == 2 else 0
+            if d not in (1, 2):
+                raise InvalidProblem(f"Wt has shape {np.shape(self.Wt)}, expected ({n}, {m}*d)")
+            set_(self, "Wt", _matrix("Wt", self.Wt, (n, m * d)))
+        gaps = np.zeros(m) if self.gaps is None else self.gaps
+        set_(self, "gaps", _matrix("gaps", gaps, (m,)))
+        if (self.gaps < 0).any():
+            j = int(np.argmax(self.gaps < 0))
+            raise InvalidProblem(f"gaps[{j}] = {self.gaps[j]:g}: must be >= 0")
+        bodies = {str(k): tuple(int(i) for i in idx) for k, idx in dict(self.bodies).items()}
+        for name, idx in bodies.items():
+            if any(i < 0 or i >= n for i in idx):
+                raise InvalidProblem(f"bodies[{name!r}] = {idx}: indices must lie in [0, {n})")
+        set_(self, "bodies", bodies)
+        asymmetry = np.abs(self.M - self.M.T).max()
+        if asymmetry > 1e-12 * np.abs(self.M).max():
+            raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
+        try:
+            set_(self, "_cholesky", scipy.linalg.cho_factor(self.M))
+        except np.linalg.LinAlgError:
+            raise InvalidProblem("M is not positive definite") from None
+
+    @property
+    def n(self) -> int:
+        """Number of generalized coordinates."""
+        return self.v.shape[0]
+
+    @property
+    def m(self) -> int:
+        """Number of contacts."""
+        return len(self.contacts)
+
+    @property
+    def d(self) -> int:
+        """Tangential directions per contact: 0 without friction, 1 planar, 2 spatial."""
+        return 0 if self.Wt is None else self.Wt.shape[1] // self.m
+
+    @property
+    def frictional(self) -> bool:
+        """Whether some contact has a tangential Jacobian and a positive mu."""
+        return self.Wt is not None and any(c.mu > 0 for c in self.contacts)
+
+    @property
+    def closed(self) -> np.ndarray:
+        """Boolean mask of the contacts with zero gap, the ones an impact involves."""
+        return self.gaps <= 0.0
+
+    def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
+        """Return ``M^-1 @ rhs`` through the cached Cholesky factor."""
+        return scipy.linalg.cho_solve(self._cholesky, rhs)
+
+    @cached_property
+    def delassus(self) -> np.ndarray:
+        """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse."""
+        G = self.Wn.T @ self.solve_mass(self.Wn)
+        G = (G + G.T) / 2
+        G.flags.writeable = False
+        return G
+
+    @cached_property
+    def un(self) -> np.ndarray:
+        """Pre-impact normal gap rates ``Wn.T @ v``."""
+        return self.Wn.T @ self.v
+
+    def restitution(self, kind: str) -> np.ndarray:
+        """Per-contact restitution coefficients of ``kind`` ('newton', 'poisson', 'energy')."""
+        return np.array([c.restitution(kind) for c in self.contacts])
+
+    def select_contacts(self, mask: np.ndarray) -> ImpactProblem:
+        """Return the problem restricted to the contacts where ``mask`` is true."""
+        mask = np.asarray(mask, dtype=bool)
+        Wt = None
+        if self.Wt is not None:
+            Wt = self.Wt.reshape(self.n, self.m, self.d)[:, mask, :].reshape(self.n, -1)
+        return dataclasses.replace(
+            self,
+            Wn=self.Wn[:, mask],
+            Wt=Wt,
+            contacts=[c for c, keep in zip(self.contacts, mask, strict=True) if keep],
+            gaps=self.gaps[mask],
+        )

@@ -1,0 +1,93 @@
+"""Registries of laws and cases, filled by the modules of a package on first use.
+
+Each module of ``lawbench.laws`` (``lawbench.cases``) registers its entry when imported. The
+modules are imported the first time a registry is asked for a name, so importing lawbench stays
+cheap; a module whose optional dependency is missing is skipped and its reason kept in
+`Registry.unavailable` instead of breaking the others.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Iterator
+from typing import Generic, Protocol, TypeVar
+
+from lawbench.errors import InvalidProblem
+
+
+class _Named(Protocol):
+    name: str
+
+
+Entry = TypeVar("Entry", bound=_Named)
+
+
+class Registry(Generic[Entry]):
+    """Name -> entry map for the entries of one kind ('law' or 'case').
+
+    Parameters
+    ----------
+    kind : str
+        What the entries are, for messages.
+    package : str
+        Dotted name of the package whose modules register entries.
+    """
+
+    def __init__(self, kind: str, package: str) -> None:
+        self.kind = kind
+        self.package = package
+        self._entries: dict[str, Entry] = {}
+        self.unavailable: dict[str, str] = {}
+        self._loaded = False
+
+    def register(self, entry: Entry) -> Entry:
+        """Add ``entry`` under its name; a name registered twice is an error."""
+        if entry.name in self._entries:
+            raise ValueError(f"{self.kind} {entry.name!r} is already registered")
+        self._entries[entry.name] = entry
+        return entry
+
+    def _load(self) -> None:
+        if self._loaded:
+            return
+        self._loaded = True
+        package = importlib.import_module(self.package)
+        for module in sorted(pkgutil.iter_modules(package.__path__), key=lambda m: m.name):
+            if module.name.startswith("_"):
+                continue
+            try:
+                importlib.import_module(f"{self.package}.{module.name}")
+            except ImportError as exc:
+                self.unavailable[module.name] = f"missing dependency: {exc}"
+
+    def get(self, name: str | Entry) -> Entry:
+        """Return the entry called ``name`` (an entry is returned as it is).
+
+        Raises
+        ------
+        InvalidProblem
+            For an unknown name; the message lists the known ones.
+        """
+        if not isinstance(name, str):
+            return name
+        self._load()
+        try:
+            return self._entries[name]
+        except KeyError:
+            known = ", ".join(self.names())
+            reason = self.unavailable.get(name)
+            extra = f" ({reason})" if reason else ""
+            raise InvalidProblem(f"unknown {self.kind} {name!r}{extra}; known: {known}") from None
+
+    def names(self) -> list[str]:
+        """Registered names, sorted."""
+        self._load()
+        return sorted(self._entries)
+
+    def __iter__(self) -> Iterator[Entry]:
+        return (self._entries[name] for name in self.names())
+
+    def __contains__(self, name: object) -> bool:
+        self._load()
+        return name in self._entries

@@ -1,0 +1,148 @@
+"""Complementarity solvers shared by the laws.
+
+The frictionless laws reduce to linear complementarity problems with a symmetric positive
+(semi)definite matrix, ``w = G z + q``, ``0 <= w _|_ z >= 0``: the optimality conditions of the
+convex QP ``min z.G z / 2 + q.z`` over ``z >= 0``. Decoupled problems (diagonal G) are solved in
+closed form; the others with clarabel, called directly with sparse matrices, then polished: the
+active set clarabel finds is solved exactly and kept when it satisfies the conditions to
+rounding, so the answer does not carry the interior-point tolerance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import clarabel
+import numpy as np
+import scipy.linalg
+import scipy.sparse
+
+from lawbench.errors import SolverFailure
+from lawbench.mechanics import is_diagonal
+
+_ACCEPTED = ("Solved",)
+ROUNDING = 1e-12
+
+
+@dataclass(frozen=True)
+class QPResult:
+    """Primal ``x`` and the multipliers ``y >= 0`` of the inequality rows, with solver facts."""
+
+    x: np.ndarray
+    y: np.ndarray
+    status: str
+    iterations: int
+
+
+def clarabel_qp(
+    P: np.ndarray, c: np.ndarray, A: np.ndarray, tol: float, max_iter: int = 200
+) -> QPResult:
+    """Solve ``min x.P x / 2 + c.x`` subject to ``A x >= 0`` with clarabel.
+
+    Raises
+    ------
+    SolverFailure
+        Unless clarabel reports 'Solved'; the message gives its status.
+    """
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.max_iter = max_iter
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
+    settings.tol_ktratio = max(tol, 1e-12)
+    solver = clarabel.DefaultSolver(
+        scipy.sparse.csc_matrix(np.triu(P)),
+        np.asarray(c, dtype=float),
+        scipy.sparse.csc_matrix(-A),
+        np.zeros(A.shape[0]),
+        [clarabel.NonnegativeConeT(A.shape[0])],
+        settings,
+    )
+    solution = solver.solve()
+    status = str(solution.status)
+    if status not in _ACCEPTED:
+        raise SolverFailure(f"clarabel status {status} after {solution.iterations} iterations")
+    return QPResult(np.array(solution.x), np.array(solution.z), status, solution.iterations)
+
+
+@dataclass(frozen=True)
+class LCPResult:
+    """Solution ``z`` of an LCP, ``w = G z + q``, and how it was found."""
+
+    z: np.ndarray
+    w: np.ndarray
+    method: str
+    solver_status: str | None = None
+    iterations: int = 0
+    polished: bool = False
+
+
+def polish(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> np.ndarray | None:
+    """Solve the active set of an approximate LCP solution exactly.
+
+    The active set is where ``z`` exceeds the slack ``w``. Returns the exact solution on that
+    set when it is complementary to rounding, else None.
+    """
+    w = G @ z + q
+    active = z > w
+    exact = np.zeros_like(q)
+    if active.any():
+        block = G[np.ix_(active, active)]
+        try:
+            exact[active] = scipy.linalg.solve(block, -q[active], assume_a="pos")
+        except (np.linalg.LinAlgError, ValueError):
+            return None
+    scale = max(np.abs(q).max(), ROUNDING)
+    slack = G @ exact + q
+    if exact.min() < -1e-10 * scale or slack.min() < -1e-10 * scale:
+        return None
+    return np.maximum(exact, 0.0)
+
+
+def solve_lcp(G: np.ndarray, q: np.ndarray, tol: float = 1e-10, refine: bool = True) -> LCPResult:
+    """Solve ``0 <= G z + q _|_ z >= 0`` for a symmetric positive semidefinite ``G``.
+
+    Parameters
+    ----------
+    G : array (m, m)
+        Symmetric positive semidefinite matrix.
+    q : array (m,)
+        Constant term.
+    tol : float
+        clarabel's tolerances (gap and feasibility).
+    refine : bool
+        Whether to polish clarabel's answer on its active set.
+    """
+    if is_diagonal(G):
+        diagonal = np.diag(G)
+        if (diagonal <= 0).any():
+            raise SolverFailure("the LCP matrix has a zero diagonal entry")
+        z = np.maximum(-q / diagonal, 0.0)
+        method = "closed form" if len(q) == 1 else "decoupled (diagonal Delassus)"
+        return LCPResult(z, G @ z + q, method)
+    result = clarabel_qp(G, q, np.eye(len(q)), tol)
+    return _finish(G, q, result.x, result, refine)
+
+
+def project_on_cone(
+    M: np.ndarray, v: np.ndarray, Wn: np.ndarray, G: np.ndarray, tol: float, refine: bool
+) -> LCPResult:
+    """Project ``v`` on ``{z : Wn.T z >= 0}`` in the metric of ``M`` with clarabel.
+
+    Returns the multipliers as an `LCPResult`: ``z`` is the impulse ``lam`` with
+    ``proj = v + M^-1 Wn lam``, and ``w = Wn.T proj``. The QP is in velocities (n unknowns);
+    its multipliers solve the LCP with matrix ``G = Wn.T M^-1 Wn`` and ``q = Wn.T v``.
+    """
+    result = clarabel_qp(M, -(M @ v), Wn.T, tol)
+    return _finish(G, Wn.T @ v, result.y, result, refine)
+
+
+def _finish(
+    G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool
+) -> LCPResult:
+    z = np.maximum(z, 0.0)
+    exact = polish(G, q, z) if refine else None
+    if exact is not None:
+        z = exact
+    return LCPResult(
+        z, G @ z + q, "LCP (clarabel)", result.status, result.iterations, exact is not None
+    )

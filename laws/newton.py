@@ -1,0 +1,68 @@
+"""Newton's kinematic restitution law, at every closed contact at once.
+
+Source: Newton's law of restitution ``un+ = -e un-``; for several contacts the generalized
+Newton law (Brogliato, *An introduction to impact dynamics*, 2010, three-ball chain,
+equation 29): every closed contact is active and ``Wn.T v+ = -E Wn.T v-`` with ``E`` the
+diagonal of the contacts' kinematic coefficients. The impulses solve ``G Pn = -(1 + E) un-``
+with ``G = Wn.T M^-1 Wn`` the Delassus matrix.
+
+Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart. The law is applied as stated to
+every closed contact, including one that is already separating (``un- > 0``), which then is
+asked to approach at ``-e un-``; the impulses are whatever the linear system gives, negative
+(tensile) ones included. Both are defects of the law, reported by the checks (``impulse_sign``,
+``admissible``, ``energy_gain``) and never corrected here.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from lawbench.errors import NotApplicable
+from lawbench.law import LAWS, Capabilities, Law
+from lawbench.mechanics import is_diagonal
+from lawbench.outcome import Outcome
+from lawbench.problem import ImpactProblem
+
+
+class Newton(Law):
+    """Generalized Newton law: ``un+ = -e un-`` at every closed contact."""
+
+    name = "newton"
+    summary = "Newton's kinematic restitution at every closed contact at once"
+    source = "Newton's law; generalized Newton law, Brogliato 2010, eq. (29)"
+    capabilities = Capabilities(several_contacts=True)
+
+    def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        G = problem.delassus
+        change = -(1.0 + problem.restitution("newton")) * problem.un
+        if is_diagonal(G):
+            Pn = change / np.diag(G)
+            formulation = "closed form" if problem.m == 1 else "decoupled (diagonal Delassus)"
+        else:
+            Pn, formulation = _solve_dependent(G, change), "linear system"
+        diagnostics = {
+            "formulation": formulation,
+            "tensile_contacts": [int(j) for j in np.flatnonzero(Pn < 0)],
+        }
+        return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
+
+
+def _solve_dependent(G: np.ndarray, change: np.ndarray) -> np.ndarray:
+    """Solve ``G P = change`` by least squares.
+
+    Dependent (redundant) contacts get the least-norm impulses; their targets must agree, or
+    the law has no solution.
+    """
+    Pn, *_ = np.linalg.lstsq(G, change, rcond=None)
+    residual = np.abs(G @ Pn - change).max()
+    if residual > 1e-9 * max(np.abs(change).max(), 1e-300):
+        raise NotApplicable(
+            "newton: the contacts are dependent and their restitution targets disagree "
+            f"(residual {residual:.3g}): the law has no solution"
+        )
+    return Pn
+
+
+LAWS.register(Newton())

@@ -1,0 +1,52 @@
+"""Poisson's kinetic restitution law in the form of Pfeiffer and Glocker.
+
+Source: Poisson's hypothesis, the expansion impulse is ``e`` times the compression impulse
+(Brogliato, *An introduction to impact dynamics*, 2010, kinetic coefficient); for several
+contacts the two complementarity problems of F. Pfeiffer and C. Glocker, *Multibody Dynamics
+with Unilateral Contacts* (Wiley, 1996), ch. 7:
+
+- compression: ``uc = un- + G Pc``, ``0 <= uc _|_ Pc >= 0``;
+- expansion: ``un+ = uc + G (E Pc + L)``, ``0 <= un+ _|_ L >= 0``, and ``Pn = (1 + E) Pc + L``.
+
+Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart. The outcome is admissible
+(``un+ >= 0``) with non-negative impulses by construction. A closed contact already separating
+before the impact receives nothing in compression unless the others push it, and in expansion
+only what keeps it from approaching (L). For one approaching contact the law equals Newton's.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from lawbench.law import LAWS, Capabilities, Law
+from lawbench.outcome import Outcome
+from lawbench.problem import ImpactProblem
+from lawbench.solvers import solve_lcp
+from lawbench.spec import Spec
+
+
+class Poisson(Law):
+    """Poisson's law: compression LCP, then expansion LCP with ``E`` times its impulse."""
+
+    name = "poisson"
+    summary = "Poisson's kinetic restitution: compression then expansion complementarity problems"
+    source = "Pfeiffer and Glocker 1996, ch. 7; Brogliato 2010, kinetic coefficient"
+    capabilities = Capabilities(several_contacts=True)
+    options = (Spec("tol", 1e-10, "clarabel's tolerances", "", "float", 0.0, 1e-2, True),)
+
+    def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        G, e = problem.delassus, problem.restitution("poisson")
+        compression = solve_lcp(G, problem.un, options["tol"])
+        restitution = e * compression.z
+        expansion = solve_lcp(G, compression.w + G @ restitution, options["tol"])
+        Pn = compression.z + restitution + expansion.z
+        diagnostics = {
+            "formulation": f"compression {compression.method}, expansion {expansion.method}",
+            "compression_impulse": compression.z.tolist(),
+            "solver_status": expansion.solver_status,
+            "iterations": compression.iterations + expansion.iterations,
+        }
+        return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
+
+
+LAWS.register(Poisson())
