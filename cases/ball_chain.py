@@ -49,6 +49,13 @@ class BallChain(Case):
     requires = Requirements(several_contacts=True)
     references = (PLASTIC_CHAIN, NEWTONS_CRADLE)
 
+    examples = {
+        "default": {},
+        "wall": {"wall": True},
+        "plastic": {"e": [0.0]},
+        "graded masses": {"n": 10, "masses": [float(k) for k in range(1, 11)], "e": [0.9]},
+    }
+
     def _check(self, params: dict[str, Any]) -> None:
         n = params["n"]
         contacts = n if params["wall"] else n - 1

@@ -95,6 +95,13 @@ class ThreeBallChain(Case):
         NEWTONS_CRADLE,
     )
 
+    examples = {
+        "default": {},
+        "head-on": {"velocities": [1.0, 0.0, -1.0], "e": [0.5, 1.0]},
+        "unequal masses": {"masses": [1.0, 10.0, 0.1], "e": [0.8]},
+        "separating contact": {"velocities": [1.0, 0.0, 0.75]},
+    }
+
     def _check(self, params: dict[str, Any]) -> None:
         exactly(params, "masses", 3, "ball")
         exactly(params, "velocities", 3, "ball")

@@ -117,6 +117,13 @@ class TwoBallsWall(Case):
         ),
     )
 
+    examples = {
+        "default": {},
+        "both approaching": {"velocities": [-2.0, -1.0], "e": [0.5, 0.8]},
+        "light outer ball": {"masses": [0.1, 1.0]},
+        "separating ball": {"velocities": [-1.0, 0.5], "e": [0.5]},
+    }
+
     def _check(self, params: dict[str, Any]) -> None:
         exactly(params, "masses", 2, "ball")
         exactly(params, "velocities", 2, "ball")

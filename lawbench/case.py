@@ -90,6 +90,8 @@ class Case(ABC):
     params: ClassVar[tuple[Spec, ...]]
     requires: ClassVar[Requirements] = Requirements()
     references: ClassVar[tuple[Reference, ...]] = ()
+    # Named parameter sets that exercise the scene; every law and check runs on each.
+    examples: ClassVar[Mapping[str, Params]] = {"default": {}}
 
     def parameters(self, **given: Any) -> dict[str, Any]:
         """Every parameter, defaults filled in, checked and converted.

@@ -72,6 +72,8 @@ class Law(ABC):
     source: ClassVar[str]
     capabilities: ClassVar[Capabilities]
     options: ClassVar[tuple[Spec, ...]] = ()
+    # Known defects of the law: (case, example, check) -> why the check fails there.
+    findings: ClassVar[dict[tuple[str, str, str], str]] = {}
 
     def option_values(self, given: dict[str, Any] | None = None) -> dict[str, Any]:
         """Return every option of this law, defaults filled in, checked and converted.

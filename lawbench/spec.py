@@ -66,8 +66,8 @@ class Spec:
         if self.low is None and self.high is None:
             return "any"
         low = "-inf" if self.low is None else f"{self.low:g}"
-        high = "inf" if self.high is None else f"{self.high:g}"
-        return f"{'(' if self.low_open else '['}{low}, {high}]"
+        high = "inf)" if self.high is None else f"{self.high:g}]"
+        return f"{'(' if self.low_open or self.low is None else '['}{low}, {high}"
 
     def coerce(self, value: Any) -> Any:
         """Return ``value`` checked and converted to this spec's kind.

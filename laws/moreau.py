@@ -8,13 +8,22 @@ and per contact ``0 <= un+ + E un- _|_ Pn >= 0`` with ``E`` the kinematic coeffi
 Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart.
 
 A closed contact that already separates before the impact (``un- > 0``) lies outside the law's
-premise (``v- in -T(q)``, every closed contact approaching or at rest). It receives no
-restitution term here: its condition is ``0 <= un+ _|_ Pn >= 0``. With the term, the law would
-allow it to approach after the impact at ``-e un-`` (an inadmissible outcome) and, per contact,
-can create kinetic energy. So the law solved is ``0 <= un+ + E min(un-, 0) _|_ Pn >= 0``:
-admissible with non-negative impulses always, and dissipative whenever no closed contact
-separates (then ``dT = sum (1 - e_j) Pn_j un-_j / 2 <= 0``). A separating contact that the
-others drag into the impact can still gain energy: a finding the ``energy_gain`` check shows.
+premise (``v- in -T(q)``: every closed contact approaching or at rest), so the law must say what
+it receives. Option ``separating``:
+
+- ``unilateral`` (default): no restitution term, only ``0 <= un+ _|_ Pn >= 0``. The law solved
+  is ``0 <= un+ + E min(un-, 0) _|_ Pn >= 0``: admissible with non-negative impulses always.
+  With the term, the contact would be allowed to approach after the impact at ``-e un-``.
+- ``restitution``: the formulas above as written, the term ``E un-`` on every closed contact.
+  For one coefficient this is the cone projection, which never creates energy for
+  ``0 <= e <= 1``, but its outcome can approach at a contact that separated.
+
+Energy: ``dT = sum_j Pn_j (un-_j + un+_j) / 2``. When no closed contact separates this is
+``sum_j (1 - e_j) Pn_j un-_j / 2 <= 0`` for both choices. A separating contact with a positive
+impulse adds ``Pn_j un-_j / 2 > 0`` (``unilateral``) or ``(1 - e_j) Pn_j un-_j / 2``
+(``restitution``): such a contact, dragged into the impact by its neighbours, can create
+energy. Neither choice is both admissible and dissipative on every scene; the checks
+``admissible`` and ``energy_gain`` report which property fails.
 
 Formulations (``diagnostics['formulation']``): closed form for one contact, decoupled for a
 diagonal Delassus matrix, the cone projection (a QP in the velocities, solved with clarabel)
@@ -55,12 +64,31 @@ class Moreau(Law):
             True,
         ),
         Spec("polish", True, "solve clarabel's active set exactly", "", "bool"),
+        Spec(
+            "separating",
+            "unilateral",
+            "what a closed contact separating before the impact receives",
+            kind="str",
+            choices=("unilateral", "restitution"),
+        ),
     )
+
+    findings = {
+        ("three_ball_chain", "separating contact", "energy_gain"): (
+            "contact 1 separates before the impact (un- = 0.75 m/s); dragged into the impact "
+            "by ball 2 it is held at un+ = 0 without restitution, and its impulse adds "
+            "Pn un- / 2 > 0 to the energy change: kinematic restitution per contact is not "
+            "dissipative once a separating contact takes part"
+        ),
+    }
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         e, un = problem.restitution("newton"), problem.un
-        approaching = np.minimum(un, 0.0)
-        single_e = len(set(e)) == 1 and not (un > 0).any()
+        if options["separating"] == "unilateral":
+            restituted = np.minimum(un, 0.0)
+        else:
+            restituted = un
+        single_e = len(set(e)) == 1 and np.array_equal(restituted, un)
         if single_e and not is_diagonal(problem.delassus):
             plastic = project_on_cone(
                 problem.M,
@@ -74,7 +102,7 @@ class Moreau(Law):
             formulation = "cone projection (clarabel)"
         else:
             result = solve_lcp(
-                problem.delassus, un + e * approaching, options["tol"], options["polish"]
+                problem.delassus, un + e * restituted, options["tol"], options["polish"]
             )
             Pn, formulation = result.z, result.method
         diagnostics = {

@@ -26,6 +26,12 @@ from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 
 
+_ASKS_APPROACH = (
+    "every closed contact is active: the wall or ball contact that separates before the "
+    "impact is asked to approach at -e un- after it"
+)
+
+
 class Newton(Law):
     """Generalized Newton law: ``un+ = -e un-`` at every closed contact."""
 
@@ -33,6 +39,14 @@ class Newton(Law):
     summary = "Newton's kinematic restitution at every closed contact at once"
     source = "Newton's law; generalized Newton law, Brogliato 2010, eq. (29)"
     capabilities = Capabilities(several_contacts=True)
+
+    findings = {
+        ("three_ball_chain", "separating contact", "admissible"): _ASKS_APPROACH,
+        ("three_ball_chain", "separating contact", "impulse_sign"): (
+            "holding contact 1 to un+ = -e un- needs a tensile impulse"
+        ),
+        ("two_balls_wall", "separating ball", "admissible"): _ASKS_APPROACH,
+    }
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         G = problem.delassus

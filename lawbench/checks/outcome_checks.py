@@ -1,0 +1,60 @@
+"""Checks that read one outcome: energy, admissibility, impulse sign, momentum."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lawbench.checks.base import TOLERANCE, Trial, check
+from lawbench.mechanics import gap_rates
+
+
+def _scale(values: np.ndarray) -> float:
+    return float(np.abs(values).max()) if values.size and np.abs(values).max() > 0 else 1.0
+
+
+@check("energy_gain")
+def energy_gain(trial: Trial) -> tuple:
+    """Relative kinetic energy change ``dT / T-``; passes unless energy is created."""
+    outcome = trial.outcome
+    relative = outcome.dT / outcome.T_minus if outcome.T_minus > 0 else outcome.dT
+    passed = relative <= TOLERANCE
+    verb = "creates" if not passed else "keeps or dissipates"
+    return relative, passed, f"{verb} energy: dT = {outcome.dT:.6g} J, T- = {outcome.T_minus:.6g} J"
+
+
+@check("admissible")
+def admissible(trial: Trial) -> tuple:
+    """Smallest post-impact gap rate of the closed contacts over the largest pre-impact one."""
+    closed = trial.problem.closed
+    if not closed.any():
+        return None, None, "no closed contact"
+    before = trial.problem.un[closed]
+    after = gap_rates(trial.problem, trial.outcome.v_plus)[closed]
+    value = float(after.min()) / _scale(before)
+    worst = int(np.flatnonzero(closed)[np.argmin(after)])
+    if value >= -TOLERANCE:
+        return value, True, "no closed contact approaches after the impact"
+    return value, False, f"contact {worst} approaches after the impact (un+ = {after.min():.6g})"
+
+
+@check("impulse_sign")
+def impulse_sign(trial: Trial) -> tuple:
+    """Smallest normal impulse over the largest one; a negative impulse is tensile."""
+    Pn = trial.outcome.Pn
+    value = float(Pn.min()) / _scale(Pn)
+    if value >= -TOLERANCE:
+        return value, True, "every normal impulse pushes apart"
+    return value, False, f"contact {int(np.argmin(Pn))} has a tensile impulse {Pn.min():.6g}"
+
+
+@check("momentum")
+def momentum(trial: Trial) -> tuple:
+    """Largest change of a conserved momentum over the largest momentum."""
+    axes = trial.case.momentum_axes(trial.params)
+    if axes is None:
+        return None, None, "the scene does not conserve momentum (a wall or a fixed point)"
+    M, v = trial.problem.M, trial.problem.v
+    change = axes @ M @ (trial.outcome.v_plus - v)
+    value = float(np.abs(change).max()) / _scale(M @ v)
+    passed = value <= TOLERANCE
+    return value, passed, f"momentum change {np.abs(change).max():.3g} kg m/s"

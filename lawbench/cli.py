@@ -1,0 +1,162 @@
+"""The ``lawbench`` command line.
+
+Exit codes: 0 done; 2 bad usage or invalid input; 3 the law does not apply; 4 solver failure;
+1 an unexpected internal error. Errors are one line on stderr, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from lawbench.api import evaluate
+from lawbench.case import CASES, Case
+from lawbench.checks import run_checks
+from lawbench.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
+from lawbench.law import LAWS, Law
+from lawbench.serialize import trial_record
+
+EXIT_CODES = {InvalidProblem: 2, NotApplicable: 3, SolverFailure: 4}
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line and exit code 2."""
+
+    def error(self, message: str) -> None:  # noqa: D102
+        self.exit(2, f"lawbench: {message} (see lawbench --help)\n")
+
+
+def _assignments(items: Sequence[str], flag: str) -> dict[str, str]:
+    values = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise InvalidProblem(f"{flag} {item!r}: expected NAME=VALUE")
+        values[name.strip()] = value.strip()
+    return values
+
+
+def _list(args: argparse.Namespace) -> None:
+    print("laws:")
+    for law in LAWS:
+        print(f"  {law.name:<16} {law.summary}")
+    print("cases:")
+    for case in CASES:
+        print(f"  {case.name:<16} {case.summary}")
+
+
+def _describe_law(law: Law) -> None:
+    caps = law.capabilities
+    print(f"law {law.name}: {law.summary}")
+    print(f"source: {law.source}")
+    print(
+        f"capabilities: friction={caps.friction} several_contacts={caps.several_contacts} "
+        f"spatial={caps.spatial} needs_stiffness={caps.needs_stiffness} "
+        f"accuracy_knob={caps.accuracy_knob}"
+    )
+    print("options:" if law.options else "options: none")
+    for spec in law.options:
+        print(f"  {spec.name} = {spec.default!r}  ({spec.describe_range()}) {spec.doc}")
+
+
+def _describe_case(case: Case) -> None:
+    params = case.parameters()
+    print(f"case {case.name}: {case.summary}")
+    print(f"coordinates (defaults): {', '.join(case.coordinates(params))}")
+    print("parameters:")
+    for spec in case.params:
+        unit = f" [{spec.unit}]" if spec.unit else ""
+        print(f"  {spec.name} = {spec.default!r}{unit}  ({spec.describe_range()}) {spec.doc}")
+    print("references:" if case.references else "references: none")
+    for ref in case.references:
+        options = "".join(f" {k}={v}" for k, v in ref.options.items())
+        print(f"  {ref.name} [{ref.law}{options}]: {ref.source}")
+
+
+def _describe(args: argparse.Namespace) -> None:
+    if args.name in LAWS:
+        _describe_law(LAWS.get(args.name))
+    elif args.name in CASES:
+        _describe_case(CASES.get(args.name))
+    else:
+        known = ", ".join(LAWS.names() + CASES.names())
+        raise InvalidProblem(f"unknown law or case {args.name!r}; known: {known}")
+
+
+def _solve(args: argparse.Namespace) -> None:
+    params = _assignments(args.set, "--set")
+    options = _assignments(args.option, "--option")
+    trial = evaluate(args.law, args.case, options, **params)
+    record = trial_record(trial, run_checks(trial))
+    if args.json:
+        print(json.dumps(record, indent=2))
+        return
+    print(f"{record['law']} on {record['case']}  (status: {record['status']})")
+    print(f"{'coordinate':<16}{'v_minus':>14}{'v_plus':>14}")
+    for name, before, after in zip(
+        record["coordinates"], record["v_minus"], record["v_plus"], strict=True
+    ):
+        print(f"{name:<16}{before:>14.6g}{after:>14.6g}")
+    print("Pn: " + ", ".join(f"{p:.6g}" for p in record["Pn"]))
+    if record["Pt"]:
+        print("Pt: " + ", ".join(f"{p:.6g}" for p in record["Pt"]))
+    print(f"T_minus = {record['T_minus']:.6g} J, T_plus = {record['T_plus']:.6g} J")
+    print(f"formulation: {record['diagnostics'].get('formulation')}")
+    for name, result in record["checks"].items():
+        verdict = {True: "pass", False: "FAIL", None: "skip"}[result["passed"]]
+        print(f"  {name:<14}{verdict:<6}{result['detail']}")
+
+
+def _report(args: argparse.Namespace) -> None:
+    from lawbench.report import write_report
+
+    path = write_report(Path(args.out))
+    print(f"report written to {path}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``lawbench`` command."""
+    parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    commands.add_parser("list", help="list the laws and cases").set_defaults(run=_list)
+    describe = commands.add_parser("describe", help="describe a law or a case")
+    describe.add_argument("name", help="a law or case name")
+    describe.set_defaults(run=_describe)
+    solve = commands.add_parser("solve", help="solve one case with one law")
+    solve.add_argument("law")
+    solve.add_argument("case")
+    solve.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a case parameter; a comma-separated value is a list",
+    )
+    solve.add_argument(
+        "--option", action="append", default=[], metavar="NAME=VALUE", help="a law option"
+    )
+    solve.add_argument("--json", action="store_true", help="print one JSON object")
+    solve.set_defaults(run=_solve)
+    report = commands.add_parser("report", help="write the comparison report")
+    report.add_argument("--out", default="reports/latest", help="output folder")
+    report.set_defaults(run=_report)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        args.run(args)
+    except LawbenchError as exc:
+        print(f"lawbench: {exc}", file=sys.stderr)
+        return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
+    except BrokenPipeError:
+        return 0
+    except Exception as exc:  # a bug: still one line, never a traceback
+        print(f"lawbench: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 1
+    return 0
