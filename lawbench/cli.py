@@ -25,7 +25,7 @@ EXIT_CODES = {InvalidProblem: 2, NotApplicable: 3, SolverFailure: 4}
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors are one line and exit code 2."""
 
-    def error(self, message: str) -> None:  # noqa: D102
+    def error(self, message: str) -> None:
         self.exit(2, f"lawbench: {message} (see lawbench --help)\n")
 
 

@@ -25,7 +25,6 @@ from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 
-
 _ASKS_APPROACH = (
     "every closed contact is active: the wall or ball contact that separates before the "
     "impact is asked to approach at -e un- after it"
