@@ -79,6 +79,8 @@ class Reference:
         for key, value in self.options.items():
             if options.get(key) != value:
                 return f"assumes {key}={value}"
+        if any(params.get("gaps", ())):
+            return "assumes every contact closed (zero gaps)"
         return self.condition(params)
 
 

@@ -30,12 +30,15 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _assignments(items: Sequence[str], flag: str) -> dict[str, str]:
-    values = {}
+    values: dict[str, str] = {}
     for item in items:
         name, sep, value = item.partition("=")
+        name = name.strip()
         if not sep or not name:
             raise InvalidProblem(f"{flag} {item!r}: expected NAME=VALUE")
-        values[name.strip()] = value.strip()
+        if name in values:
+            raise InvalidProblem(f"{flag} {name} is given twice")
+        values[name] = value.strip()
     return values
 
 
@@ -92,7 +95,7 @@ def _solve(args: argparse.Namespace) -> None:
     trial = evaluate(args.law, args.case, options, **params)
     record = trial_record(trial, run_checks(trial))
     if args.json:
-        print(json.dumps(record, indent=2))
+        print(json.dumps(record, indent=2, allow_nan=False))
         return
     print(f"{record['law']} on {record['case']}  (status: {record['status']})")
     print(f"{'coordinate':<16}{'v_minus':>14}{'v_plus':>14}")
@@ -148,7 +151,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exit_:  # usage errors and --help
+        return int(exit_.code or 0)
     try:
         args.run(args)
     except LawbenchError as exc:

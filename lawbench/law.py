@@ -133,7 +133,7 @@ class Law(ABC):
             outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
             outcome.diagnostics["formulation"] = "no closed contact"
         wall_time = time.perf_counter() - start
-        for field in ("v_plus", "Pn", "Pt"):
+        for field in ("v_plus", "Pn", "Pt", "T_plus"):
             if not np.all(np.isfinite(getattr(outcome, field))):
                 raise SolverFailure(f"{self.name}: non-finite {field} {getattr(outcome, field)}")
         outcome.diagnostics["options"] = values

@@ -185,6 +185,10 @@ class ImpactProblem:
             set_(self, "_cholesky", scipy.linalg.cho_factor(self.M))
         except np.linalg.LinAlgError:
             raise InvalidProblem("M is not positive definite") from None
+        with np.errstate(over="ignore", invalid="ignore"):
+            energy = float(self.v @ self.M @ self.v)
+        if not math.isfinite(energy):
+            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({energy})")
 
     @property
     def n(self) -> int:

@@ -3,9 +3,11 @@
 The frictionless laws reduce to linear complementarity problems with a symmetric positive
 (semi)definite matrix, ``w = G z + q``, ``0 <= w _|_ z >= 0``: the optimality conditions of the
 convex QP ``min z.G z / 2 + q.z`` over ``z >= 0``. Decoupled problems (diagonal G) are solved in
-closed form; the others with clarabel, called directly with sparse matrices, then polished: the
-active set clarabel finds is solved exactly and kept when it satisfies the conditions to
-rounding, so the answer does not carry the interior-point tolerance.
+closed form. The others either with clarabel, called directly with sparse matrices, then
+polished (the active set clarabel finds is solved exactly and kept when it satisfies the
+conditions to rounding, so the answer does not carry the interior-point tolerance); or as the
+non-negative least-squares problem ``min |R z + R^-T q|`` with ``G = R.T R``, whose active-set
+method (Lawson and Hanson) is finite and exact.
 """
 
 from __future__ import annotations
@@ -15,12 +17,12 @@ from dataclasses import dataclass
 import clarabel
 import numpy as np
 import scipy.linalg
+import scipy.optimize
 import scipy.sparse
 
 from lawbench.errors import SolverFailure
 from lawbench.mechanics import is_diagonal
 
-_ACCEPTED = ("Solved",)
 ROUNDING = 1e-12
 
 
@@ -39,10 +41,7 @@ def clarabel_qp(
 ) -> QPResult:
     """Solve ``min x.P x / 2 + c.x`` subject to ``A x >= 0`` with clarabel.
 
-    Raises
-    ------
-    SolverFailure
-        Unless clarabel reports 'Solved'; the message gives its status.
+    Returns whatever clarabel ended with; the caller decides whether its status will do.
     """
     settings = clarabel.DefaultSettings()
     settings.verbose = False
@@ -58,10 +57,9 @@ def clarabel_qp(
         settings,
     )
     solution = solver.solve()
-    status = str(solution.status)
-    if status not in _ACCEPTED:
-        raise SolverFailure(f"clarabel status {status} after {solution.iterations} iterations")
-    return QPResult(np.array(solution.x), np.array(solution.z), status, solution.iterations)
+    return QPResult(
+        np.array(solution.x), np.array(solution.z), str(solution.status), solution.iterations
+    )
 
 
 @dataclass(frozen=True)
@@ -98,7 +96,9 @@ def polish(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> np.ndarray | None:
     return np.maximum(exact, 0.0)
 
 
-def solve_lcp(G: np.ndarray, q: np.ndarray, tol: float = 1e-10, refine: bool = True) -> LCPResult:
+def solve_lcp(
+    G: np.ndarray, q: np.ndarray, tol: float = 1e-10, refine: bool = True, method: str = "clarabel"
+) -> LCPResult:
     """Solve ``0 <= G z + q _|_ z >= 0`` for a symmetric positive semidefinite ``G``.
 
     Parameters
@@ -111,6 +111,8 @@ def solve_lcp(G: np.ndarray, q: np.ndarray, tol: float = 1e-10, refine: bool = T
         clarabel's tolerances (gap and feasibility).
     refine : bool
         Whether to polish clarabel's answer on its active set.
+    method : {'clarabel', 'nnls'}
+        The solver of coupled problems.
     """
     if is_diagonal(G):
         diagonal = np.diag(G)
@@ -119,8 +121,27 @@ def solve_lcp(G: np.ndarray, q: np.ndarray, tol: float = 1e-10, refine: bool = T
         z = np.maximum(-q / diagonal, 0.0)
         method = "closed form" if len(q) == 1 else "decoupled (diagonal Delassus)"
         return LCPResult(z, G @ z + q, method)
+    if method == "nnls":
+        return _nnls_lcp(G, q)
     result = clarabel_qp(G, q, np.eye(len(q)), tol)
     return _finish(G, q, result.x, result, refine)
+
+
+def _nnls_lcp(G: np.ndarray, q: np.ndarray) -> LCPResult:
+    """The LCP as non-negative least squares, through a square root ``R`` of ``G``."""
+    values, vectors = np.linalg.eigh(G)
+    keep = values > 1e-13 * values.max()
+    root = np.sqrt(values[keep])
+    R = root[:, None] * vectors[:, keep].T
+    target = -(vectors[:, keep].T @ q) / root
+    try:
+        z, _ = scipy.optimize.nnls(R, target, maxiter=50 * len(q))
+    except RuntimeError as exc:
+        raise SolverFailure(f"NNLS active-set method failed: {exc}") from None
+    w = G @ z + q
+    if w.min() < -1e-9 * max(np.abs(q).max(), ROUNDING):
+        raise SolverFailure(f"NNLS answer violates the LCP by {-w.min():.3g}: no solution")
+    return LCPResult(z, w, "LCP (active set, NNLS)")
 
 
 def project_on_cone(
@@ -139,10 +160,13 @@ def project_on_cone(
 def _finish(
     G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool
 ) -> LCPResult:
+    """Polish clarabel's answer; a status other than 'Solved' is accepted only when polished."""
     z = np.maximum(z, 0.0)
-    exact = polish(G, q, z) if refine else None
+    exact = polish(G, q, z) if refine and np.isfinite(z).all() else None
     if exact is not None:
         z = exact
+    elif result.status != "Solved":
+        raise SolverFailure(f"clarabel status {result.status} after {result.iterations} iterations")
     return LCPResult(
         z, G @ z + q, "LCP (clarabel)", result.status, result.iterations, exact is not None
     )

@@ -1,0 +1,413 @@
+"""The ``lawbench`` command line: a stable contract that other tools script against.
+
+Most calls run the command as a real subprocess (``python -m lawbench``, the same entry point
+as the console script); the exit codes that need a law to misbehave on purpose call
+`lawbench.cli.main` in the test process with a monkeypatched law.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import lawbench
+from lawbench import cli
+
+CONSOLE_SCRIPT = Path(sys.executable).parent / "lawbench"
+RECORD_KEYS = {
+    "law",
+    "case",
+    "params",
+    "coordinates",
+    "v_minus",
+    "v_plus",
+    "Pn",
+    "Pt",
+    "T_minus",
+    "T_plus",
+    "checks",
+    "status",
+    "diagnostics",
+}
+
+
+def command_line(*args: str, script: bool = False) -> list[str]:
+    """The argument vector of ``python -m lawbench ARGS`` or of the console script."""
+    prefix = [str(CONSOLE_SCRIPT)] if script else [sys.executable, "-m", "lawbench"]
+    return [*prefix, *args]
+
+
+def run_together(*commands: list[str]) -> list[subprocess.CompletedProcess]:
+    """Run the commands as concurrent subprocesses; return their results in order."""
+    processes = [
+        subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        for command in commands
+    ]
+    results = []
+    for command, process in zip(commands, processes, strict=True):
+        try:
+            stdout, stderr = process.communicate(timeout=120)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            raise
+        results.append(subprocess.CompletedProcess(command, process.returncode, stdout, stderr))
+    return results
+
+
+def run_lawbench(*args: str, script: bool = False) -> subprocess.CompletedProcess:
+    """Run the command line in a subprocess and capture its output as text."""
+    return run_together(command_line(*args, script=script))[0]
+
+
+def strict_json(text: str) -> dict:
+    """Parse ``text`` as standard JSON: NaN and Infinity tokens are refused."""
+
+    def refuse(token: str) -> None:
+        raise ValueError(f"non-standard JSON token {token}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def solve_json(*args: str) -> dict:
+    """Run ``lawbench solve ARGS --json``, check it succeeded and return the parsed record."""
+    result = run_lawbench("solve", *args, "--json")
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+    record = strict_json(result.stdout)
+    assert isinstance(record, dict)
+    return record
+
+
+def section(text: str, title: str) -> list[str]:
+    """First words of the indented lines that follow the line ``title``, up to the next title."""
+    lines = text.splitlines()
+    start = lines.index(title) + 1
+    names = []
+    for line in lines[start:]:
+        if not line.startswith("  "):
+            break
+        names.append(line.split()[0])
+    return names
+
+
+# 1. list and describe
+
+
+def test_list_prints_every_registered_law_and_case():
+    result = run_lawbench("list")
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+    assert section(result.stdout, "laws:") == lawbench.LAWS.names()
+    assert section(result.stdout, "cases:") == lawbench.CASES.names()
+
+
+def test_describe_case_prints_parameters_coordinates_and_references():
+    case = lawbench.CASES.get("three_ball_chain")
+    result = run_lawbench("describe", "three_ball_chain")
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    assert section(out, "parameters:") == [spec.name for spec in case.params]
+    coordinates = case.coordinates(case.parameters())
+    assert coordinates
+    assert all(name in out for name in coordinates)
+    assert case.references
+    reference_lines = out.split("references:", 1)[1]
+    for reference in case.references:
+        assert reference.name in reference_lines
+        assert f"[{reference.law}" in reference_lines
+
+
+def test_describe_law_prints_its_options():
+    law = lawbench.LAWS.get("moreau")
+    result = run_lawbench("describe", "moreau")
+    assert result.returncode == 0, result.stderr
+    assert law.options
+    assert section(result.stdout, "options:") == [spec.name for spec in law.options]
+    for spec in law.options:
+        assert repr(spec.default) in result.stdout
+
+
+# 2. solve --json
+
+
+def test_solve_json_record_has_the_documented_shape():
+    case = lawbench.CASES.get("three_ball_chain")
+    record = solve_json("moreau", "three_ball_chain")
+    assert set(record) == RECORD_KEYS
+    assert record["law"] == "moreau"
+    assert record["case"] == "three_ball_chain"
+    assert record["params"] == case.parameters()
+    assert list(record["params"]) == [spec.name for spec in case.params]
+    assert record["coordinates"] == case.coordinates(case.parameters())
+    n = len(record["coordinates"])
+    assert len(record["v_minus"]) == n
+    assert len(record["v_plus"]) == n
+    assert record["Pt"] == []
+    assert isinstance(record["T_minus"], float)
+    assert isinstance(record["T_plus"], float)
+    assert isinstance(record["status"], str)
+    assert set(record["checks"]) == set(lawbench.CHECKS)
+    for name, result in record["checks"].items():
+        assert set(result) == {"value", "passed", "detail"}, name
+        assert result["passed"] in (True, False, None), name
+        assert isinstance(result["detail"], str), name
+
+
+def test_solve_set_fills_a_list_and_a_scalar_and_keeps_other_defaults():
+    case = lawbench.CASES.get("three_ball_chain")
+    record = solve_json(
+        "newton",
+        "three_ball_chain",
+        "--set",
+        "velocities=1,0,0",
+        "--set",
+        "e=0.5",
+        "--set",
+        "exponent=1",
+    )
+    params = record["params"]
+    assert set(params) == {spec.name for spec in case.params}
+    assert params["velocities"] == [1.0, 0.0, 0.0]
+    assert record["v_minus"] == [1.0, 0.0, 0.0]
+    # One restitution coefficient serves every contact.
+    assert params["e"] and set(params["e"]) == {0.5}
+    assert params["exponent"] == 1.0
+    defaults = case.parameters()
+    for name in ("masses", "stiffness_ratio", "gaps"):
+        assert params[name] == defaults[name], name
+    # The value set changes the result: e = 0.5 dissipates energy, the default e = 1 does not.
+    assert record["T_plus"] < record["T_minus"]
+
+
+def test_solve_option_reaches_the_sequential_law():
+    args = ["solve", "sequential", "three_ball_chain", "--json"]
+    results = run_together(
+        command_line(*args), command_line(*args, "--option", "order=right_to_left")
+    )
+    for result in results:
+        assert result.returncode == 0, result.stderr
+    default, chosen = (strict_json(result.stdout) for result in results)
+    assert chosen["diagnostics"]["options"]["order"] == "right_to_left"
+    assert default["diagnostics"]["options"]["order"] != "right_to_left"
+    assert "right_to_left" in chosen["diagnostics"]["formulation"]
+
+
+def test_solve_without_json_prints_a_readable_table():
+    result = run_lawbench("solve", "newton", "three_ball_chain")
+    assert result.returncode == 0, result.stderr
+    case = lawbench.CASES.get("three_ball_chain")
+    for name in case.coordinates(case.parameters()):
+        assert name in result.stdout
+    for name in lawbench.CHECKS:
+        assert name in result.stdout
+
+
+# 3. determinism
+
+
+# The laws with an iterative solver (clarabel) or a sequence of steps.
+@pytest.mark.parametrize("law", ["moreau", "poisson", "sequential"])
+def test_solve_json_is_deterministic_apart_from_wall_time(law):
+    args = ["solve", law, "three_ball_chain", "--set", "velocities=1,0,-1", "--set", "e=0.5,1"]
+    records = []
+    for result in run_together(command_line(*args, "--json"), command_line(*args, "--json")):
+        assert result.returncode == 0, result.stderr
+        record = strict_json(result.stdout)
+        wall_time = record["diagnostics"].pop("wall_time_s")
+        assert isinstance(wall_time, float)
+        assert wall_time >= 0
+        assert "wall_time_s" not in json.dumps(record)
+        records.append(record)
+    assert records[0] == records[1]
+    # Identical text, key order included.
+    assert json.dumps(records[0]) == json.dumps(records[1])
+
+
+# 4. bad input
+
+
+def assert_one_line_error(result: subprocess.CompletedProcess, code: int) -> str:
+    """Check the exit code, one stderr line and no traceback; return that line."""
+    assert result.returncode == code, (result.returncode, result.stdout, result.stderr)
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert result.stdout == ""
+    return lines[0]
+
+
+def listing(names: list[str]) -> list[str]:
+    """Patterns matching each of ``names`` in a message."""
+    return [re.escape(name) for name in names]
+
+
+LAWS = lawbench.LAWS.names()
+CASES = lawbench.CASES.names()
+CHAIN_PARAMETERS = [spec.name for spec in lawbench.CASES.get("three_ball_chain").params]
+SEQUENTIAL_OPTIONS = [spec.name for spec in lawbench.LAWS.get("sequential").options]
+BAD_INPUT = [
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--set", "e=1.5"],
+        [r"(?<![\w'\[])e(\[\d+\])?(?!\w)", r"1\.5"],
+        id="restitution-above-one",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--set", "masses=1,-1,1"],
+        [r"masses\[1\]", "-1"],
+        id="negative-mass",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--set", "velocities=1,0"],
+        [r"\bvelocities\b"],
+        id="wrong-number-of-velocities",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--set", "velocities=nan,0,0"],
+        [r"velocities\[0\]", "(?i)nan"],
+        id="nan-velocity",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--set", "foo=1"],
+        ["foo", *listing(CHAIN_PARAMETERS)],
+        id="unknown-parameter",
+    ),
+    pytest.param(
+        ["solve", "foo", "three_ball_chain"],
+        ["foo", *listing(LAWS)],
+        id="unknown-law",
+    ),
+    pytest.param(
+        ["solve", "newton", "foo"],
+        ["foo", *listing(CASES)],
+        id="unknown-case",
+    ),
+    pytest.param(
+        ["solve", "sequential", "three_ball_chain", "--option", "bogus=1"],
+        ["bogus", *listing(SEQUENTIAL_OPTIONS)],
+        id="unknown-option",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--set", "e0.5"],
+        ["--set", "e0.5"],
+        id="set-without-equals",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--option", "order"],
+        ["--option", "order"],
+        id="option-without-equals",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--json", "--set", "velocities=1e200,0,0"],
+        [r"\bv\b", "overflows"],
+        id="kinetic-energy-overflow",
+    ),
+    pytest.param(
+        ["solve", "newton", "three_ball_chain", "--set", "e=1", "--set", "e=0"],
+        ["--set e", "twice"],
+        id="parameter-given-twice",
+    ),
+    pytest.param(["frobnicate"], ["frobnicate"], id="unknown-subcommand"),
+    pytest.param(["describe", "foo"], ["foo"], id="describe-unknown-name"),
+]
+
+
+@pytest.mark.parametrize(("args", "patterns"), BAD_INPUT)
+def test_bad_input_exits_2_with_one_line_naming_the_culprit(args, patterns):
+    line = assert_one_line_error(run_lawbench(*args), 2)
+    for pattern in patterns:
+        assert re.search(pattern, line), (pattern, line)
+
+
+def test_main_returns_the_usage_exit_code_instead_of_raising(capsys):
+    assert cli.main(["frobnicate"]) == 2
+    assert "frobnicate" in capsys.readouterr().err
+    assert cli.main(["solve"]) == 2
+
+
+def test_solver_failure_exits_4_with_one_line():
+    result = run_lawbench(
+        "solve", "sequential", "two_balls_wall", "--set", "e=0", "--option", "max_impacts=5"
+    )
+    line = assert_one_line_error(result, 4)
+    assert "5" in line
+
+
+def test_same_scene_without_the_impact_bound_succeeds():
+    # The failure above comes from max_impacts, not from the scene.
+    record = solve_json("sequential", "two_balls_wall", "--set", "e=0")
+    assert set(record) == RECORD_KEYS
+    assert record["diagnostics"]["impacts"] > 5
+    assert record["Pt"] == []
+    assert len(record["Pn"]) == 2
+
+
+@pytest.mark.parametrize(
+    ("error", "code"),
+    [
+        pytest.param(lawbench.NotApplicable("x"), 3, id="not-applicable"),
+        pytest.param(lawbench.SolverFailure("x"), 4, id="solver-failure"),
+        pytest.param(RuntimeError("x"), 1, id="internal-error"),
+    ],
+)
+def test_main_maps_law_errors_to_exit_codes(monkeypatch, capsys, error, code):
+    law = lawbench.LAWS.get("newton")
+
+    def resolve(problem, **options):
+        raise error
+
+    monkeypatch.setattr(law, "resolve", resolve)
+    assert cli.main(["solve", "newton", "three_ball_chain", "--json"]) == code
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    lines = captured.err.splitlines()
+    assert len(lines) == 1, captured.err
+    assert "Traceback" not in captured.err
+    assert lines[0].endswith("x")
+    # Nothing stays patched: the law resolves again.
+    monkeypatch.undo()
+    assert "resolve" not in vars(law)
+    assert cli.main(["solve", "newton", "three_ball_chain", "--json"]) == 0
+
+
+# 5. python -m and the console script
+
+
+def test_console_script_and_python_m_print_the_same_list():
+    assert CONSOLE_SCRIPT.exists(), CONSOLE_SCRIPT
+    script, module = run_together(command_line("list", script=True), command_line("list"))
+    assert script.returncode == module.returncode == 0
+    assert script.stdout == module.stdout
+    assert script.stdout.strip()
+
+
+def test_console_script_reports_bad_input_like_python_m():
+    args = ["solve", "newton", "three_ball_chain", "--set", "e=1.5"]
+    script, module = run_together(command_line(*args, script=True), command_line(*args))
+    assert assert_one_line_error(script, 2) == assert_one_line_error(module, 2)
+
+
+# 6. report
+
+
+def test_report_writes_its_three_files(tmp_path):
+    out = tmp_path / "report"
+    result = run_lawbench("report", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    assert str(out) in result.stdout
+    for name in ("report.md", "index.html", "comparison.csv"):
+        assert (out / name).is_file(), name
+        assert (out / name).stat().st_size > 0, name
+    markdown = (out / "report.md").read_text()
+    for name in lawbench.LAWS.names():
+        assert name in markdown, name
+    with (out / "comparison.csv").open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert {row["law"] for row in rows} == set(lawbench.LAWS.names())
+    assert {row["case"] for row in rows} <= set(lawbench.CASES.names())
+    assert "<table" in (out / "index.html").read_text()

@@ -1,0 +1,132 @@
+"""Validation of impact problems, case parameters and law options."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import lawbench
+from lawbench import Contact, ImpactProblem, InvalidProblem
+
+
+def two_balls(**changes):
+    fields = {
+        "M": np.diag([1.0, 2.0]),
+        "Wn": np.array([[-1.0], [1.0]]),
+        "v": np.array([1.0, 0.0]),
+        "contacts": [Contact(e=0.5)],
+    }
+    fields.update(changes)
+    return ImpactProblem(**fields)
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"M": np.diag([1.0, -2.0])}, "M is not positive definite"),
+        ({"M": np.array([[1.0, 0.5], [0.0, 1.0]])}, "M is not symmetric"),
+        ({"M": np.eye(3)}, r"M has shape \(3, 3\)"),
+        ({"Wn": np.ones((3, 1))}, r"Wn has shape \(3, 1\)"),
+        ({"v": np.array([np.nan, 0.0])}, r"v\[0\] = nan"),
+        ({"v": np.array([1.0, np.inf])}, r"v\[1\] = inf"),
+        ({"contacts": [Contact(e=1.5)]}, r"contacts\[0\]\.e = 1\.5"),
+        ({"contacts": [Contact(mu=-0.1)]}, r"contacts\[0\]\.mu = -0\.1"),
+        ({"contacts": [Contact(stiffness=0.0)]}, r"contacts\[0\]\.stiffness = 0"),
+        ({"contacts": [Contact(e_poisson=-0.2)]}, r"contacts\[0\]\.e_poisson"),
+        ({"contacts": []}, "contacts is empty"),
+        ({"gaps": np.array([-1.0])}, r"gaps\[0\] = -1"),
+        ({"Wt": np.ones((2, 3))}, "Wt has shape"),
+        ({"bodies": {"ball": (0, 5)}}, r"bodies\['ball'\]"),
+    ],
+)
+def test_bad_fields_are_refused_by_name(changes, message):
+    with pytest.raises(InvalidProblem, match=message):
+        two_balls(**changes)
+
+
+def test_invalid_problem_is_a_value_error():
+    assert issubclass(InvalidProblem, ValueError)
+
+
+def test_problem_arrays_are_read_only_and_laws_do_not_mutate():
+    problem = two_balls()
+    with pytest.raises(ValueError, match="read-only"):
+        problem.v[0] = 3.0
+    before = problem.v.copy()
+    for law in lawbench.LAWS:
+        law.resolve(problem)
+    assert np.array_equal(problem.v, before)
+
+
+def test_restitution_overrides():
+    contact = Contact(e=0.5, e_poisson=0.3)
+    assert contact.restitution("newton") == 0.5
+    assert contact.restitution("poisson") == 0.3
+
+
+def test_open_contacts_are_left_alone():
+    """A contact with a positive gap is not part of the impact: zero impulse."""
+    outcome = lawbench.solve("moreau", "three_ball_chain", gaps=[0.0, 0.01])
+    np.testing.assert_allclose(outcome.v_plus, [0.0, 1.0, 0.0], atol=1e-14)
+    assert outcome.Pn[1] == 0.0
+    all_open = lawbench.solve("newton", "three_ball_chain", gaps=[0.1, 0.1])
+    assert all_open.diagnostics["formulation"] == "no closed contact"
+    np.testing.assert_array_equal(all_open.v_plus, [1.0, 0.0, 0.0])
+
+
+def test_references_assume_closed_contacts():
+    """With open gaps the rigid laws leave the chain alone; eq. (29) no longer describes it."""
+    trial = lawbench.evaluate("newton", "three_ball_chain", gaps=[1.0, 1.0])
+    result = lawbench.CHECKS["reference"](trial)
+    assert result.passed is None
+    assert "zero gaps" in result.detail
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ({"e": 1.5}, r"e\[0\] = 1\.5"),
+        ({"masses": [1, -1, 1]}, r"masses\[1\] = -1"),
+        ({"masses": [1, 0, 1]}, r"masses\[1\] = 0"),
+        ({"velocities": [1, 0]}, "velocities has 2 values, expected 3"),
+        ({"velocities": [float("nan"), 0, 0]}, r"velocities\[0\] = nan"),
+        ({"velocities": "1,x,0"}, r"velocities\[1\] = 'x': not a number"),
+        ({"e": [0.5, 0.5, 0.5]}, "e has 3 values, expected 1 or 2"),
+        ({"stiffness_ratio": 0}, "stiffness_ratio = 0"),
+        ({"colour": "red"}, "unknown parameter 'colour'.*known: masses"),
+    ],
+)
+def test_bad_case_parameters_are_refused_by_name(params, message):
+    with pytest.raises(InvalidProblem, match=message):
+        lawbench.solve("newton", "three_ball_chain", **params)
+
+
+def test_ball_chain_parameters():
+    case = lawbench.CASES.get("ball_chain")
+    params = case.parameters(n=4, velocities=[2.0])
+    assert params["velocities"] == [2.0, 0.0, 0.0, 0.0]
+    assert params["masses"] == [1.0] * 4
+    assert case.build(n=4, wall=True).m == 4
+    with pytest.raises(InvalidProblem, match="n = 1"):
+        case.parameters(n=1)
+    with pytest.raises(InvalidProblem, match="more than n = 2"):
+        case.parameters(n=2, velocities=[1, 2, 3])
+    with pytest.raises(InvalidProblem, match="wall = 'maybe'"):
+        case.parameters(wall="maybe")
+
+
+def test_bad_law_options_are_refused_by_name():
+    with pytest.raises(InvalidProblem, match="unknown option 'speed' for law 'sequential'"):
+        lawbench.solve("sequential", "three_ball_chain", {"speed": 1})
+    with pytest.raises(InvalidProblem, match="order = 'random'"):
+        lawbench.solve("sequential", "three_ball_chain", {"order": "random"})
+    with pytest.raises(InvalidProblem, match="tol = 0"):
+        lawbench.solve("moreau", "three_ball_chain", {"tol": 0})
+
+
+def test_select_contacts_keeps_the_chosen_columns():
+    problem = lawbench.CASES.get("three_ball_chain").build()
+    only = problem.select_contacts(np.array([False, True]))
+    assert only.m == 1
+    np.testing.assert_array_equal(only.Wn[:, 0], problem.Wn[:, 1])
+    assert dataclasses.replace(problem).m == 2
