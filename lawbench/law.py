@@ -133,6 +133,8 @@ class Law(ABC):
             outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
             outcome.diagnostics["formulation"] = "no closed contact"
         wall_time = time.perf_counter() - start
+        if problem.Wt is not None and outcome.Pt.size == 0:
+            outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
         for field in ("v_plus", "Pn", "Pt", "T_plus"):
             if not np.all(np.isfinite(getattr(outcome, field))):
                 raise SolverFailure(f"{self.name}: non-finite {field} {getattr(outcome, field)}")
@@ -150,7 +152,7 @@ def _embed(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outc
     Pn = np.zeros(problem.m)
     Pn[closed] = outcome.Pn
     Pt = outcome.Pt
-    if Pt.size:
+    if Pt.size and problem.d:
         Pt = np.zeros((problem.m, problem.d))
         Pt[closed] = outcome.Pt.reshape(-1, problem.d)
         Pt = Pt.ravel()

@@ -232,6 +232,33 @@ class ImpactProblem:
         """Pre-impact normal gap rates ``Wn.T @ v``."""
         return self.Wn.T @ self.v
 
+    @cached_property
+    def W(self) -> np.ndarray:
+        """Contact Jacobian ``[Wn, Wt]`` (n, m + m*d): normal columns, then tangential."""
+        return self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
+
+    @cached_property
+    def contact_delassus(self) -> np.ndarray:
+        """Delassus matrix of normal and tangential directions ``W.T M^-1 W``.
+
+        Blocks: ``[[Gnn, Gnt], [Gtn, Gtt]]`` with the m normal rows first, then the m*d
+        tangential rows (contact j's tangential rows are ``m + j*d ... m + j*d + d - 1``).
+        """
+        G = self.W.T @ self.solve_mass(self.W)
+        G = (G + G.T) / 2
+        G.flags.writeable = False
+        return G
+
+    @cached_property
+    def ut(self) -> np.ndarray:
+        """Pre-impact tangential slip velocities ``Wt.T @ v`` (m*d,); empty without Wt."""
+        return np.zeros(0) if self.Wt is None else self.Wt.T @ self.v
+
+    @property
+    def mu(self) -> np.ndarray:
+        """Friction coefficients, one per contact."""
+        return np.array([c.mu for c in self.contacts])
+
     def restitution(self, kind: str) -> np.ndarray:
         """Per-contact restitution coefficients of ``kind`` ('newton', 'poisson', 'energy')."""
         return np.array([c.restitution(kind) for c in self.contacts])

@@ -1,4 +1,4 @@
-"""Checks that read one outcome: energy, admissibility, impulse sign, momentum."""
+"""Checks that read one outcome: energy, admissibility, impulse sign, friction, momentum."""
 
 from __future__ import annotations
 
@@ -45,6 +45,22 @@ def impulse_sign(trial: Trial) -> tuple:
     if value >= -TOLERANCE:
         return value, True, "every normal impulse pushes apart"
     return value, False, f"contact {int(np.argmin(Pn))} has a tensile impulse {Pn.min():.6g}"
+
+
+@check("friction_cone")
+def friction_cone(trial: Trial) -> tuple:
+    """Largest excess ``|Pt_j| - mu_j Pn_j`` over the largest impulse; <= 0 inside the cones."""
+    problem, outcome = trial.problem, trial.outcome
+    if problem.Wt is None:
+        return None, None, "the scene has no tangential direction (frictionless)"
+    tangential = np.linalg.norm(outcome.Pt.reshape(problem.m, problem.d), axis=1)
+    excess = tangential - problem.mu * outcome.Pn
+    value = float(excess.max()) / _scale(np.concatenate([outcome.Pn, outcome.Pt]))
+    if value <= TOLERANCE:
+        return value, True, "every tangential impulse lies in its friction cone"
+    j = int(np.argmax(excess))
+    bound = problem.mu[j] * outcome.Pn[j]
+    return value, False, f"contact {j}: |Pt| = {tangential[j]:.6g} exceeds mu Pn = {bound:.6g}"
 
 
 @check("momentum")
