@@ -72,6 +72,9 @@ class Law(ABC):
     source: ClassVar[str]
     capabilities: ClassVar[Capabilities]
     options: ClassVar[tuple[Spec, ...]] = ()
+    # Whether the law follows contacts through their gaps (resolves time): then it receives the
+    # whole problem; otherwise only the closed contacts, an open one being no part of the impact.
+    follows_gaps: ClassVar[bool] = False
     # Known defects of the law: (case, example, check) -> why the check fails there.
     findings: ClassVar[dict[tuple[str, str, str], str]] = {}
 
@@ -123,7 +126,7 @@ class Law(ABC):
             raise NotApplicable(f"{self.name}: {reason}")
         closed = problem.closed
         start = time.perf_counter()
-        if closed.all():
+        if closed.all() or self.follows_gaps:
             outcome = self._resolve(problem, values)
         elif closed.any():
             outcome = _embed(
