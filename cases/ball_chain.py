@@ -3,7 +3,8 @@
 Generalized coordinates: the velocities v1 ... vn of the balls, left to right (m/s, positive to
 the right). Contact i (0-based) is between balls i+1 and i+2, gap rate ``v[i+1] - v[i]``; with
 ``wall`` true, the last contact is between ball n and a fixed wall on its right, gap rate
-``-vn``. Every contact has stiffness 1 N/m^exponent. ``velocities`` gives the first balls; the
+``-vn``. ``stiffness`` and ``exponent`` are one value for every contact or one per contact
+(default 1 N/m^1.5, Hertz). ``velocities`` gives the first balls; the
 ones it leaves out are at rest, so the default is one ball striking a chain at rest (the
 Newton's cradle of the textbooks). Source: Brogliato, *An introduction to impact dynamics*
 (2010), chains of balls.
@@ -43,7 +44,16 @@ class BallChain(Case):
         velocities_spec([1.0], "pre-impact velocities of the first balls; the rest are at rest"),
         restitution_spec(),
         Spec("wall", False, "a fixed wall right of the last ball, as the last contact", "", "bool"),
-        exponent_spec(),
+        Spec(
+            "stiffness",
+            [1.0],
+            "contact stiffness, one value or one per contact",
+            "N/m^exponent",
+            "floats",
+            0.0,
+            low_open=True,
+        ),
+        exponent_spec("floats"),
         gaps_spec(1),
     )
     requires = Requirements(several_contacts=True)
@@ -66,6 +76,8 @@ class BallChain(Case):
         params["velocities"] = velocities + [0.0] * (n - len(velocities))
         per_item(params, "e", contacts, "contact")
         per_item(params, "gaps", contacts, "contact")
+        per_item(params, "stiffness", contacts, "contact")
+        per_item(params, "exponent", contacts, "contact")
 
     def _build(self, params: dict[str, Any]) -> ImpactProblem:
         n = params["n"]
@@ -77,8 +89,8 @@ class BallChain(Case):
             params["velocities"],
             pairs=pairs,
             restitution=params["e"],
-            stiffness=[1.0] * len(pairs),
-            exponent=params["exponent"],
+            stiffness=params["stiffness"],
+            exponents=params["exponent"],
             gaps=params["gaps"],
         )
 

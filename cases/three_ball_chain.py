@@ -115,7 +115,7 @@ class ThreeBallChain(Case):
             pairs=[(0, 1), (1, 2)],
             restitution=params["e"],
             stiffness=[1.0, params["stiffness_ratio"]],
-            exponent=params["exponent"],
+            exponents=[params["exponent"]] * 2,
             gaps=params["gaps"],
         )
 

@@ -137,7 +137,7 @@ class TwoBallsWall(Case):
             pairs=[(1, 0), (None, 1)],
             restitution=params["e"],
             stiffness=[1.0, params["stiffness_ratio"]],
-            exponent=params["exponent"],
+            exponents=[params["exponent"]] * 2,
             gaps=params["gaps"],
         )
 

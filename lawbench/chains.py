@@ -25,7 +25,7 @@ def chain_problem(
     pairs: Sequence[Pair],
     restitution: Sequence[float],
     stiffness: Sequence[float],
-    exponent: float,
+    exponents: Sequence[float],
     gaps: Sequence[float] | None = None,
 ) -> ImpactProblem:
     """Return the impact problem of balls on a line touching along ``pairs``.
@@ -36,10 +36,8 @@ def chain_problem(
         Ball masses (kg) and velocities (m/s, positive to the right).
     pairs : sequence of m (left, right) pairs
         Ball indices, or None for a fixed wall on that side.
-    restitution, stiffness : sequences of m floats
-        Restitution coefficient and stiffness of each contact.
-    exponent : float
-        Force-indentation exponent of every contact.
+    restitution, stiffness, exponents : sequences of m floats
+        Restitution coefficient, stiffness and force-indentation exponent of each contact.
     gaps : sequence of m floats, optional
         Initial gaps (m); zero by default.
     """
@@ -51,8 +49,8 @@ def chain_problem(
         if right is not None:
             Wn[right, j] = 1.0
     contacts = [
-        Contact(e=e, stiffness=k, exponent=exponent)
-        for e, k in zip(restitution, stiffness, strict=True)
+        Contact(e=e, stiffness=k, exponent=n)
+        for e, k, n in zip(restitution, stiffness, exponents, strict=True)
     ]
     return ImpactProblem(
         M=np.diag(np.asarray(masses, dtype=float)),
@@ -86,14 +84,17 @@ def restitution_spec() -> Spec:
     )
 
 
-def exponent_spec() -> Spec:
-    """The ``exponent`` parameter: force-indentation exponent of the contacts."""
+def exponent_spec(kind: str = "float") -> Spec:
+    """The ``exponent`` parameter: force-indentation exponent of the contacts.
+
+    ``kind`` 'floats' makes it one value or one per contact.
+    """
     return Spec(
         "exponent",
-        1.5,
+        1.5 if kind == "float" else [1.5],
         "force-indentation exponent (1 linear, 1.5 Hertz)",
         "",
-        "float",
+        kind,
         0.0,
         low_open=True,
     )
