@@ -38,3 +38,28 @@ def gap_rates(problem: ImpactProblem, v: np.ndarray) -> np.ndarray:
 def is_diagonal(G: np.ndarray) -> bool:
     """Whether the Delassus matrix decouples the contacts (no off-diagonal term)."""
     return not np.any(G - np.diag(np.diag(G)))
+
+
+def kinetic_angles(problem: ImpactProblem) -> np.ndarray:
+    """Angles (degrees) between the contact constraints in the kinetic metric, (m, m).
+
+    ``cos(theta_ij) = G_ij / sqrt(G_ii G_jj)`` with ``G`` the Delassus matrix (Brogliato 2010,
+    eq. 26: two balls on a wall, ``cos(theta_12) = -sqrt(m1 / (m1 + m2))``). Paoli's condition:
+    rigid laws with e > 0 are continuous in the initial data only where the angles are right
+    angles (orthogonal constraints).
+    """
+    G = problem.delassus
+    scale = np.sqrt(np.diag(G))
+    cosine = np.clip(G / np.outer(scale, scale), -1.0, 1.0)
+    return np.degrees(np.arccos(cosine))
+
+
+def energy_shares(problem: ImpactProblem, v: np.ndarray) -> dict[str, float]:
+    """Share of the kinetic energy at ``v`` carried by each body (``problem.bodies``)."""
+    total = kinetic_energy(problem.M, v)
+    shares = {}
+    for name, indices in problem.bodies.items():
+        idx = list(indices)
+        own = kinetic_energy(problem.M[np.ix_(idx, idx)], v[idx])
+        shares[name] = own / total if total > 0 else 0.0
+    return shares

@@ -1,10 +1,21 @@
 """Checks of an outcome: each returns a value, a verdict and a reason, or is skipped with one.
 
-``energy_gain``, ``admissible``, ``impulse_sign``, ``momentum`` and ``reference`` read one
-trial (a law solved on a case); `run_checks` runs them all.
+Single-solve checks read one trial (a law solved on a case): ``energy_gain``, ``admissible``,
+``impulse_sign``, ``friction_cone``, ``momentum``, ``reference``; `run_checks` runs them by
+default. ``continuity`` and ``dispersion`` solve the case again and run on request.
 """
 
-from lawbench.checks import outcome_checks, reference
-from lawbench.checks.base import CHECKS, CheckResult, Trial, run_checks
+from lawbench.checks import continuity, dispersion, outcome_checks, reference
+from lawbench.checks.base import CHECKS, SINGLE_SOLVE, CheckResult, Trial, run_checks
 
-__all__ = ["CHECKS", "CheckResult", "Trial", "outcome_checks", "reference", "run_checks"]
+__all__ = [
+    "CHECKS",
+    "SINGLE_SOLVE",
+    "CheckResult",
+    "Trial",
+    "continuity",
+    "dispersion",
+    "outcome_checks",
+    "reference",
+    "run_checks",
+]

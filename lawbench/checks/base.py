@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from lawbench.case import Case
@@ -25,6 +25,8 @@ class Trial:
     options: dict[str, Any]
     problem: ImpactProblem
     outcome: Outcome
+    # Settings of the checks that solve again (for example continuity's perturbation sizes).
+    settings: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -43,12 +45,15 @@ class CheckResult:
 
 Check = Callable[[Trial], CheckResult]
 CHECKS: dict[str, Check] = {}
+# The checks that read the one outcome of a trial; the others solve the case again.
+SINGLE_SOLVE: list[str] = []
 
 
-def check(name: str) -> Callable[[Callable[[Trial], tuple]], Check]:
+def check(name: str, several_solves: bool = False) -> Callable[[Callable[[Trial], tuple]], Check]:
     """Register a function returning ``(value, passed, detail)`` as the check ``name``.
 
     The function returns ``(None, None, reason)`` when the check does not apply.
+    ``several_solves`` marks a check that solves the case again (costly; run on request).
     """
 
     def register(function: Callable[[Trial], tuple]) -> Check:
@@ -57,11 +62,13 @@ def check(name: str) -> Callable[[Callable[[Trial], tuple]], Check]:
 
         run.__doc__ = function.__doc__
         CHECKS[name] = run
+        if not several_solves:
+            SINGLE_SOLVE.append(name)
         return run
 
     return register
 
 
 def run_checks(trial: Trial, names: list[str] | None = None) -> dict[str, CheckResult]:
-    """Run the named checks (all by default) on ``trial``, in registration order."""
-    return {name: CHECKS[name](trial) for name in names or CHECKS}
+    """Run the named checks on ``trial`` (by default every single-solve check), in order."""
+    return {name: CHECKS[name](trial) for name in names or SINGLE_SOLVE}

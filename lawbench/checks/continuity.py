@@ -1,0 +1,86 @@
+"""Continuity of an outcome in the initial data (gaps and velocities).
+
+The case is solved again under vanishing perturbations: small initial gaps that let one contact
+close first (each contact in turn), and small velocity perturbations at zero gaps, at each size
+of ``settings['continuity_sizes']`` (default 1e-2, 1e-4, 1e-6; gaps in metres, velocity changes
+relative to the largest velocity). A rigid law meets the gaps event by event
+(`lawbench.events.resolve_with_gaps`). The value is the outcome jump that remains at the
+smallest size, relative to the largest velocity; continuous when it is below 1e-3. The detail
+gives the jumps per size and the kinetic angles between the contacts, which by Paoli's
+condition (Brogliato 2010, 'kinetic angle and continuity') predict where rigid laws must be
+discontinuous: angles other than 90 degrees with e > 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from lawbench.checks.base import Trial, check
+from lawbench.errors import LawbenchError
+from lawbench.events import resolve_with_gaps
+from lawbench.mechanics import kinetic_angles
+
+SIZES = (1e-2, 1e-4, 1e-6)
+CONTINUOUS = 1e-3
+
+
+def jumps(trial: Trial, sizes: tuple[float, ...] = SIZES) -> dict[str, list[float]]:
+    """Outcome jump per size, for gap perturbations and for velocity perturbations."""
+    problem, law, options = trial.problem, trial.law, trial.options
+    base = trial.outcome.v_plus
+    scale = float(np.abs(problem.v).max())
+    directions = np.random.default_rng(0).normal(size=(3, problem.n))
+    directions /= np.abs(directions).max(axis=1, keepdims=True)
+    result: dict[str, list[float]] = {"gaps": [], "velocities": []}
+    for size in sizes:
+        gap_jump = 0.0
+        for first in range(problem.m):
+            gaps = np.full(problem.m, size)
+            gaps[first] = 0.0
+            moved = resolve_with_gaps(law, dataclasses.replace(problem, gaps=gaps), options)
+            gap_jump = max(gap_jump, float(np.abs(moved.v_plus - base).max()) / scale)
+        velocity_jump = 0.0
+        for direction in directions:
+            pushed = dataclasses.replace(problem, v=problem.v + size * scale * direction)
+            moved = law.resolve(pushed, **options)
+            velocity_jump = max(velocity_jump, float(np.abs(moved.v_plus - base).max()) / scale)
+        result["gaps"].append(gap_jump)
+        result["velocities"].append(velocity_jump)
+    return result
+
+
+@check("continuity", several_solves=True)
+def continuity(trial: Trial) -> tuple:
+    """Outcome jump left at the smallest perturbation; continuous below 1e-3."""
+    problem = trial.problem
+    if problem.m < 2:
+        return None, None, "one contact: no order of closing to perturb"
+    if problem.gaps.any():
+        return None, None, "the scene starts with gaps: continuity is probed at zero gaps"
+    sizes = tuple(trial.settings.get("continuity_sizes", SIZES))
+    try:
+        found = jumps(trial, sizes)
+    except LawbenchError as exc:
+        return None, None, f"a perturbed solve failed: {type(exc).__name__}: {exc}"
+    value = max(found["gaps"][-1], found["velocities"][-1])
+    angles = kinetic_angles(problem)
+    pairs = ", ".join(
+        f"{i}-{j}: {angles[i, j]:.1f} deg"
+        for i in range(problem.m)
+        for j in range(i + 1, problem.m)
+    )
+    detail = (
+        f"jump under gaps {_list(found['gaps'])}, under velocities {_list(found['velocities'])} "
+        f"at sizes {_list(sizes)}; kinetic angles {pairs}"
+    )
+    return (
+        value,
+        value <= CONTINUOUS,
+        ("continuous: " if value <= CONTINUOUS else "discontinuous: ") + detail,
+    )
+
+
+def _list(values: tuple[float, ...] | list[float]) -> str:
+    return "[" + ", ".join(f"{x:.2g}" for x in values) + "]"

@@ -1,0 +1,194 @@
+"""Run specifications: grids of laws x cases x parameters x options, expanded deterministically.
+
+A specification is a TOML file (or the same built from the command line)::
+
+    seed = 0                                  # random samples are drawn from this seed
+    checks = ["energy_gain", "continuity"]    # optional; default: every single-solve check
+
+    [[grid]]
+    laws = ["newton", "moreau"]               # or ["*"]: every law that can treat the case
+    cases = ["three_ball_chain"]              # or ["*"]
+    params = { e = [0.0, 0.5, 1.0], stiffness_ratio = { logrange = [-3, 3, 7] } }
+    options = { moreau = { tol = [1e-6, 1e-10] } }
+
+    [[grid]]
+    cases = ["*"]
+    examples = true                           # each case's named examples as parameter sets
+
+A parameter or option takes a list of values, one value, ``{range = [start, stop, count]}``
+(evenly spaced), ``{logrange = [start_exponent, stop_exponent, count]}`` (powers of ten), or
+``{random = [low, high, count], log = false, size = 1}`` (uniform samples, drawn from the
+spec's seed and the grid, parameter and draw position, so the same spec always gives the same
+values; ``size`` > 1 draws vectors). Rows are the Cartesian product in the order written:
+cases, then laws, then parameters, then options. Every row is checked before any work: an
+unknown name or a value out of range raises `InvalidProblem`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import tomllib
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lawbench.case import CASES
+from lawbench.checks import CHECKS, SINGLE_SOLVE
+from lawbench.errors import InvalidProblem
+from lawbench.law import LAWS
+
+
+@dataclass(frozen=True)
+class Row:
+    """One unit of work: a law with options on a case with parameters."""
+
+    index: int
+    law: str
+    case: str
+    params: dict[str, Any]
+    options: dict[str, Any]
+
+    @property
+    def key(self) -> str:
+        """A stable identity of the row's content, for resuming."""
+        text = json.dumps([self.law, self.case, self.params, self.options], sort_keys=True)
+        return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """A parsed specification: grids, the seed, the checks to run and their settings."""
+
+    grids: Sequence[Mapping[str, Any]]
+    seed: int = 0
+    checks: Sequence[str] = field(default_factory=lambda: list(SINGLE_SOLVE))
+    continuity_sizes: Sequence[float] = (1e-2, 1e-4, 1e-6)
+
+    @classmethod
+    def from_toml(cls, path: Path) -> RunSpec:
+        """Read a specification file; a malformed one raises `InvalidProblem`."""
+        try:
+            data = tomllib.loads(Path(path).read_text())
+        except OSError as exc:
+            raise InvalidProblem(f"spec {path}: cannot be read ({exc.strerror})") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise InvalidProblem(f"spec {path}: malformed TOML ({exc})") from None
+        return cls.from_dict(data)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RunSpec:
+        """Build a specification from parsed TOML; unknown keys raise `InvalidProblem`."""
+        unknown = set(data) - {"grid", "seed", "checks", "continuity_sizes"}
+        if unknown:
+            raise InvalidProblem(f"spec: unknown key {sorted(unknown)[0]!r}")
+        grids = data.get("grid", [])
+        if not grids:
+            raise InvalidProblem("spec: no [[grid]] table")
+        checks = list(data.get("checks", SINGLE_SOLVE))
+        for name in checks:
+            if name not in CHECKS:
+                raise InvalidProblem(f"spec: unknown check {name!r}; known: {', '.join(CHECKS)}")
+        sizes = tuple(float(s) for s in data.get("continuity_sizes", (1e-2, 1e-4, 1e-6)))
+        return cls(grids, int(data.get("seed", 0)), checks, sizes)
+
+    def rows(self) -> list[Row]:
+        """Every row, in order, each checked against its law and case."""
+        rows: list[Row] = []
+        for number, grid in enumerate(self.grids):
+            for law, case, params, options in _expand(grid, self.seed, number):
+                rows.append(Row(len(rows), law, case, params, options))
+        return rows
+
+
+GRID_KEYS = {"laws", "cases", "params", "options", "examples"}
+
+
+def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
+    names = grid.get(key, ["*"])
+    if isinstance(names, str):
+        names = [names]
+    if names == ["*"]:
+        return registry.names()
+    for name in names:
+        registry.get(name)
+    return list(names)
+
+
+def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[tuple]:
+    unknown = set(grid) - GRID_KEYS
+    if unknown:
+        raise InvalidProblem(f"spec grid {number}: unknown key {sorted(unknown)[0]!r}")
+    every_law = grid.get("laws", ["*"]) in (["*"], "*")
+    laws, cases = _names(grid, "laws", LAWS), _names(grid, "cases", CASES)
+    param_values = {
+        name: values(spec, seed, (number, "param", name))
+        for name, spec in dict(grid.get("params", {})).items()
+    }
+    option_grids = dict(grid.get("options", {}))
+    for law in option_grids:
+        LAWS.get(law)
+    for case_name in cases:
+        case = CASES.get(case_name)
+        for law_name in laws:
+            law = LAWS.get(law_name)
+            if every_law and not case.requires.met_by(law.capabilities):
+                continue
+            option_values = {
+                name: values(spec, seed, (number, "option", law_name, name))
+                for name, spec in dict(option_grids.get(law_name, {})).items()
+            }
+            parameter_sets = (
+                [dict(p) for p in case.examples.values()]
+                if grid.get("examples", False)
+                else list(_product(param_values))
+            )
+            for params in parameter_sets:
+                for options in _product(option_values):
+                    try:
+                        case.parameters(**params)
+                        law.option_values(options)
+                    except InvalidProblem as exc:
+                        raise InvalidProblem(
+                            f"spec grid {number}, {law_name} on {case_name}: {exc}"
+                        ) from None
+                    yield law_name, case_name, params, options
+
+
+def _product(choices: Mapping[str, list[Any]]) -> Iterator[dict[str, Any]]:
+    names = list(choices)
+    for combination in itertools.product(*(choices[name] for name in names)):
+        yield dict(zip(names, combination, strict=True))
+
+
+def values(spec: Any, seed: int, where: tuple) -> list[Any]:
+    """The values a grid entry stands for (see the module docstring)."""
+    if isinstance(spec, list):
+        return spec
+    if not isinstance(spec, Mapping):
+        return [spec]
+    label = "/".join(str(part) for part in where)
+    try:
+        if "range" in spec:
+            start, stop, count = spec["range"]
+            return np.linspace(start, stop, int(count)).tolist()
+        if "logrange" in spec:
+            start, stop, count = spec["logrange"]
+            return np.logspace(start, stop, int(count)).tolist()
+        if "random" in spec:
+            low, high, count = spec["random"]
+            size = int(spec.get("size", 1))
+            digest = hashlib.sha1(label.encode()).digest()
+            rng = np.random.default_rng([seed, int.from_bytes(digest[:8], "little")])
+            if spec.get("log", False):
+                draws = 10 ** rng.uniform(np.log10(low), np.log10(high), (int(count), size))
+            else:
+                draws = rng.uniform(low, high, (int(count), size))
+            return [row[0] if size == 1 else row for row in draws.tolist()]
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"spec {label}: bad value generator {dict(spec)} ({exc})") from None
+    raise InvalidProblem(f"spec {label}: unknown value generator {dict(spec)}")
