@@ -1,0 +1,113 @@
+"""Continuity in the initial data, kinetic angles and energy dispersion."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import lawbench
+from lawbench.checks.continuity import jumps
+from lawbench.checks.dispersion import dispersion_index
+from lawbench.events import resolve_with_gaps
+from lawbench.mechanics import energy_shares, kinetic_angles
+
+# Both contacts approach, so either can close first.
+HEAD_ON = {"velocities": [1.0, 0.0, -1.0], "e": [0.5]}
+
+
+def gapped(problem, first, size):
+    gaps = np.full(problem.m, size)
+    gaps[first] = 0.0
+    return dataclasses.replace(problem, gaps=gaps)
+
+
+@pytest.mark.parametrize("law", ["newton", "poisson", "moreau"])
+def test_rigid_laws_tend_to_binary_impacts_in_the_closing_order(law):
+    """Brogliato 2010, 'kinetic angle and continuity' (Paoli): on the three-ball chain the
+    angle between the contacts is 120 degrees, so under vanishing gaps a rigid law meets the
+    contacts one at a time: binary impacts in the closing order. The two orders disagree and
+    neither is the simultaneous outcome: discontinuous.
+    """
+    trial = lawbench.evaluate(law, "three_ball_chain", **HEAD_ON)
+    order = {0: "left_to_right", 1: "right_to_left"}
+    ends = {}
+    for first in (0, 1):
+        binary = lawbench.solve(
+            "sequential", "three_ball_chain", {"order": order[first]}, **HEAD_ON
+        ).v_plus
+        for size in (1e-2, 1e-4, 1e-6):
+            moved = resolve_with_gaps(trial.law, gapped(trial.problem, first, size), {})
+            np.testing.assert_allclose(moved.v_plus, binary, atol=1e-12)
+        ends[first] = binary
+    simultaneous = trial.outcome.v_plus
+    assert np.abs(ends[0] - ends[1]).max() > 0.05
+    assert min(np.abs(end - simultaneous).max() for end in ends.values()) > 0.05
+    result = lawbench.CHECKS["continuity"](trial)
+    assert result.passed is False
+    assert "120.0 deg" in result.detail
+
+
+def test_compliant_contacts_are_continuous_in_the_gaps():
+    """Compliant contacts resolve time inside the impact: as the gaps shrink the outcome
+    converges to the zero-gap one (PHYSICS_NOTES, 'Continuity')."""
+    trial = lawbench.evaluate("compliant", "three_ball_chain", **HEAD_ON)
+    found = jumps(trial, (1e-2, 1e-4, 1e-6))
+    assert found["gaps"][0] > found["gaps"][1] > found["gaps"][2]
+    assert found["gaps"][2] < 1e-4
+    assert lawbench.CHECKS["continuity"](trial).passed is True
+
+
+@pytest.mark.parametrize("law", ["moreau", "compliant"])
+def test_velocity_perturbations_at_zero_gaps_are_continuous(law):
+    trial = lawbench.evaluate(law, "three_ball_chain", **HEAD_ON)
+    found = jumps(trial, (1e-2, 1e-4, 1e-6))
+    assert found["velocities"][2] < 1e-5
+    assert found["velocities"][0] > found["velocities"][2]
+
+
+@pytest.mark.parametrize("masses", [(1.0, 1.0), (0.2, 3.0), (5.0, 0.5)])
+def test_kinetic_angle_of_two_balls_on_a_wall(masses):
+    """Brogliato 2010, eq. (26): cos(theta_12) = -sqrt(m1 / (m1 + m2))."""
+    problem = lawbench.CASES.get("two_balls_wall").build(masses=list(masses))
+    m1, m2 = masses
+    expected = np.degrees(np.arccos(-np.sqrt(m1 / (m1 + m2))))
+    assert kinetic_angles(problem)[0, 1] == pytest.approx(expected, abs=1e-10)
+
+
+def test_dispersion_between_the_two_limits():
+    """Three equal balls, (1, 0, 0): sequential impacts give the textbook non-dispersive
+    outcome (all energy in ball 3), Moreau at e = 1 the dispersive (-1/3, 2/3, 2/3), and the
+    compliant model moves from the first to the second as the stiffness ratio goes from 0 to
+    infinity (Brogliato 2010, 'Three-ball chain with linear springs').
+    """
+    problem = lawbench.CASES.get("three_ball_chain").build()
+    sequential = energy_shares(problem, lawbench.solve("sequential", "three_ball_chain").v_plus)
+    assert dispersion_index(sequential) == pytest.approx(0.0, abs=1e-12)
+    moreau = energy_shares(problem, lawbench.solve("moreau", "three_ball_chain").v_plus)
+    np.testing.assert_allclose(list(moreau.values()), [1 / 9, 4 / 9, 4 / 9], atol=1e-12)
+    indices = [
+        dispersion_index(
+            energy_shares(
+                problem,
+                lawbench.solve(
+                    "compliant",
+                    "three_ball_chain",
+                    {"model": "hertz"},
+                    exponent=1,
+                    stiffness_ratio=ratio,
+                ).v_plus,
+            )
+        )
+        for ratio in (1e-4, 1e-2, 1.0, 1e2, 1e4)
+    ]
+    assert indices[0] < 1e-3
+    assert indices[-1] == pytest.approx(dispersion_index(moreau), abs=1e-3)
+    assert indices[0] < indices[2] < indices[-1]
+
+
+def test_dispersion_check_compares_with_the_compliant_model():
+    sequential = lawbench.CHECKS["dispersion"](lawbench.evaluate("sequential", "three_ball_chain"))
+    moreau = lawbench.CHECKS["dispersion"](lawbench.evaluate("moreau", "three_ball_chain"))
+    assert sequential.passed is True
+    assert moreau.passed is False
+    assert "index" in moreau.detail
