@@ -120,6 +120,19 @@ def _report(args: argparse.Namespace) -> None:
     print(f"report written to {path}")
 
 
+def _table(args: argparse.Namespace) -> None:
+    from lawbench.tables import build_table
+
+    table = build_table(args.name)
+    print(table.text())
+    if args.out:
+        try:
+            path = table.write_csv(Path(args.out))
+        except OSError as exc:
+            raise InvalidProblem(f"--out {args.out}: cannot write ({exc.strerror})") from None
+        print(f"table written to {path}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lawbench`` command."""
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
@@ -146,6 +159,10 @@ def build_parser() -> argparse.ArgumentParser:
     report = commands.add_parser("report", help="write the comparison report")
     report.add_argument("--out", default="reports/latest", help="output folder")
     report.set_defaults(run=_report)
+    table = commands.add_parser("table", help="tabulate a study of several laws (CSV)")
+    table.add_argument("name", help="rocking_block or sphere_wall")
+    table.add_argument("--out", metavar="FILE", help="write the table as CSV to FILE")
+    table.set_defaults(run=_table)
     return parser
 
 

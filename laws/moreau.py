@@ -1,11 +1,24 @@
-"""Moreau's impact law: projection on the tangent cone in the kinetic metric.
+"""Moreau's impact law: projection on the tangent cone in the kinetic metric, Coulomb cones.
 
 Source: J.J. Moreau (1983, 1985, 1988) as given by Brogliato, *An introduction to impact
 dynamics* (2010), equations (16)-(17):
 ``v+ = -e v- + (1 + e) argmin { |z - v-|_M^2 / 2 : Wn.T z >= 0 }`` for one coefficient ``e``,
 and per contact ``0 <= un+ + E un- _|_ Pn >= 0`` with ``E`` the kinematic coefficients.
+With friction, Moreau's (1988) contact law in the local velocities ``u+ = W.T v+``
+(``W = [Wn, Wt]``) and impulses ``P_j = (Pn_j, Pt_j)`` in the Coulomb cones
+``K_j = {|Pt_j| <= mu_j Pn_j}``, written with De Saxce and Feng's (1991) bipotential:
+the modified velocity ``uhat_j = (un+_j + e_j r_j + mu_j |ut+_j|, ut+_j)`` satisfies
+``K_j ∋ P_j _|_ uhat_j ∈ K*_j``, ``K*_j = {mu_j |w_t| <= w_n}`` the dual cone. This is
+exactly Coulomb's law with the normal law above: no impulse and ``un+_j + e_j r_j >= 0``
+(free), ``un+_j + e_j r_j = 0`` with ``ut+_j = 0`` and ``|Pt_j| <= mu_j Pn_j`` (stick), or
+``un+_j + e_j r_j = 0`` with ``Pt_j = -mu_j Pn_j ut+_j / |ut+_j|`` (slip). Acary, Cadoux,
+Lemarechal and Malick (ZAMM 91, 2011) solve it as a fixed point over convex problems, and
+Anitescu (Math. Program. 105, 2006) drops the term ``mu_j |ut+_j|``, a convex relaxation.
 
-Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart.
+Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart; ``ut = Wt.T v``, contact j's
+tangential columns ``j*d ... j*d + d - 1`` (``d = 1`` planar, 2 spatial); ``Pt_j`` opposes the
+post-impact slip ``ut+_j``; ``r_j`` is the restituted gap rate (option ``separating``): the
+restitution acts on the normal direction only.
 
 A closed contact that already separates before the impact (``un- > 0``) lies outside the law's
 premise (``v- in -T(q)``: every closed contact approaching or at rest), so the law must say what
@@ -25,10 +38,37 @@ impulse adds ``Pn_j un-_j / 2 > 0`` (``unilateral``) or ``(1 - e_j) Pn_j un-_j /
 energy. Neither choice is both admissible and dissipative on every scene; the checks
 ``admissible`` and ``energy_gain`` report which property fails.
 
-Formulations (``diagnostics['formulation']``): closed form for one contact, decoupled for a
-diagonal Delassus matrix, the cone projection (a QP in the velocities, solved with clarabel)
-for one coefficient when no closed contact separates, and the LCP in the impulses (a QP in
-``Pn >= 0``, solved with clarabel) otherwise.
+Formulations (``diagnostics['formulation']``). Without friction (no ``Wt``, or every
+``mu = 0``): closed form for one contact, decoupled for a diagonal Delassus matrix, the cone
+projection (a QP in the velocities, solved with clarabel) for one coefficient when no closed
+contact separates, and the LCP in the impulses (a QP in ``Pn >= 0``, solved with clarabel)
+otherwise. With friction, the second-order cone QP in the impulses
+``min P.G P / 2 + (q + s).P`` over the cones ``K_j`` (``G`` the contact Delassus matrix,
+``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clarabel
+(`lawbench.cones`); option ``friction``:
+
+- ``coulomb`` (default, "SOCP fixed point (clarabel)"): the exact law. Starting from
+  ``s = 0``, each step fixes ``s_j = mu_j |ut+_j|`` from the previous solution and solves the
+  convex problem, until ``s`` changes by less than ``tol`` times the largest ``|q|``. Its
+  optimality conditions are then De Saxce's. The iteration need not converge: the law may
+  have several solutions or none when normal and tangential directions are strongly coupled,
+  and even where it has one the iterates can cycle (seen on a random planar problem with two
+  contacts). More than ``max_fixed_point`` steps raise `SolverFailure` with the count.
+- ``relaxed`` ("SOCP relaxed (clarabel)"): one convex problem with ``s = 0``, Anitescu's
+  relaxation. Its conditions are ``un+_j + e_j r_j >= mu_j |ut+_j|`` instead of ``>= 0``: a
+  slipping contact leaves with the extra normal rate ``mu_j |ut+_j|`` (it may separate where
+  Coulomb's law keeps it closed); sticking and free contacts are as in Coulomb's law.
+
+``polish`` refines each cone QP's answer and the final one on the contact states they show
+(Newton's method on the equations of each state) and keeps a refinement when it satisfies the
+cone conditions better; an answer clarabel only 'AlmostSolved' must be refined or raises
+`SolverFailure`. Diagnostics: ``fixed_point_steps`` (cone QPs solved), ``iterations``
+(clarabel's, summed over them), ``solver_status`` (the last one's), ``polished``.
+
+With ``e = 0`` the exact law never creates energy,
+``dT = -sum_j mu_j Pn_j |ut+_j| - P.G P / 2 <= 0``. With ``e > 0`` it can, like Whittaker's law
+(the same law at one contact): on the falling rod and the double pendulum the slip reverses
+and ``-e Pn un-`` outweighs the losses.
 """
 
 from __future__ import annotations
@@ -37,6 +77,8 @@ from typing import Any
 
 import numpy as np
 
+from lawbench import cones
+from lawbench.errors import SolverFailure
 from lawbench.law import LAWS, Capabilities, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
@@ -44,32 +86,69 @@ from lawbench.problem import ImpactProblem
 from lawbench.solvers import project_on_cone, solve_lcp
 from lawbench.spec import Spec
 
+_SLIP_REVERSAL = (
+    "kinematic restitution with Coulomb friction on the post-impact slip (at one contact "
+    "Whittaker's law, Brogliato 2010 eq. 8): the slip reverses during the impact and "
+    "dT = -e Pn un- - mu Pn |ut+| - P.G P / 2 is positive for e close to 1 with strong "
+    "normal-tangential coupling"
+)
+
 
 class Moreau(Law):
-    """Moreau's law: ``0 <= un+ + E min(un-, 0) _|_ Pn >= 0``, a cone projection for one e."""
+    """Moreau's law: ``0 <= un+ + E min(un-, 0) _|_ Pn >= 0``; Coulomb cones with friction."""
 
     name = "moreau"
-    summary = "Moreau's law: cone projection in the kinetic metric, LCP per contact (clarabel)"
-    source = "Moreau 1988; Brogliato 2010, eqs. (16)-(17)"
-    capabilities = Capabilities(several_contacts=True, accuracy_knob="tol")
+    summary = (
+        "Moreau's law: cone projection in the kinetic metric, LCP per contact; Coulomb cones "
+        "as second-order cones (clarabel)"
+    )
+    source = (
+        "Moreau 1988; Brogliato 2010, eqs. (16)-(17); De Saxce and Feng 1991; Acary et al. "
+        "2011; Anitescu 2006"
+    )
+    capabilities = Capabilities(
+        friction=True, several_contacts=True, spatial=True, accuracy_knob="tol"
+    )
     options = (
         Spec(
             "tol",
             1e-10,
-            "clarabel's tolerances (gap and feasibility)",
+            "clarabel's tolerances (gap and feasibility); with friction also the fixed point's "
+            "(change of mu |ut+| over the largest local velocity)",
             "",
             "float",
             0.0,
             1e-2,
             True,
         ),
-        Spec("polish", True, "solve clarabel's active set exactly", "", "bool"),
+        Spec(
+            "polish",
+            True,
+            "solve clarabel's active set (with friction: contact states) exactly",
+            "",
+            "bool",
+        ),
         Spec(
             "separating",
             "unilateral",
             "what a closed contact separating before the impact receives",
             kind="str",
             choices=("unilateral", "restitution"),
+        ),
+        Spec(
+            "friction",
+            "coulomb",
+            "Coulomb's law exactly (fixed point over cone QPs) or Anitescu's convex relaxation",
+            kind="str",
+            choices=("coulomb", "relaxed"),
+        ),
+        Spec(
+            "max_fixed_point",
+            1000,
+            "bound on the cone QPs of the exact Coulomb law's fixed point",
+            "",
+            "int",
+            1,
         ),
     )
 
@@ -80,6 +159,8 @@ class Moreau(Law):
             "Pn un- / 2 > 0 to the energy change: kinematic restitution per contact is not "
             "dissipative once a separating contact takes part"
         ),
+        ("falling_rod", "energy gain", "energy_gain"): _SLIP_REVERSAL,
+        ("double_pendulum", "default", "energy_gain"): _SLIP_REVERSAL,
     }
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
@@ -88,6 +169,8 @@ class Moreau(Law):
             restituted = np.minimum(un, 0.0)
         else:
             restituted = un
+        if problem.frictional:
+            return _resolve_friction(problem, e * restituted, options)
         single_e = len(set(e)) == 1 and np.array_equal(restituted, un)
         if single_e and not is_diagonal(problem.delassus):
             plastic = project_on_cone(
@@ -112,6 +195,48 @@ class Moreau(Law):
             "polished": result.polished,
         }
         return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
+
+
+def _resolve_friction(
+    problem: ImpactProblem, restitution: np.ndarray, options: dict[str, Any]
+) -> Outcome:
+    """Impulses in the Coulomb cones: one cone QP (relaxed) or their fixed point (exact).
+
+    ``restitution`` is ``E r``, added to the normal local velocities.
+    """
+    m, d, mu, G = problem.m, problem.d, problem.mu, problem.contact_delassus
+    q = problem.W.T @ problem.v
+    q[:m] += restitution
+    exact, tol = options["friction"] == "coulomb", options["tol"]
+    s, steps, iterations = np.zeros(m), 0, 0
+    while True:
+        result = cones.solve_cone_qp(G, q + np.pad(s, (0, m * d)), mu, d, tol, options["polish"])
+        steps, iterations = steps + 1, iterations + result.iterations
+        P, polished = result.P, result.polished
+        if not exact:
+            break
+        slip = np.linalg.norm(cones.split(G @ P + q, m, d)[1], axis=1)
+        change, s = np.abs(mu * slip - s).max(), mu * slip
+        if change <= tol * np.abs(q).max():
+            break
+        if steps >= options["max_fixed_point"]:
+            raise SolverFailure(
+                f"moreau: the Coulomb fixed point did not converge in {steps} steps "
+                f"(last change of mu |ut+| {change:.3g}, tolerance {tol:g})"
+            )
+    if exact and options["polish"]:
+        # The last cone QP had the previous s; solve Coulomb's law itself on its states.
+        refined = cones.polish(G, q, mu, d, P, True)
+        P, polished = (P, polished) if refined is None else (refined, True)
+    Pn, Pt = P[:m], P[m:]
+    diagnostics = {
+        "formulation": f"SOCP {'fixed point' if exact else 'relaxed'} (clarabel)",
+        "solver_status": result.status,
+        "iterations": iterations,
+        "fixed_point_steps": steps,
+        "polished": polished,
+    }
+    return Outcome.from_impulses(problem, Pn, Pt, diagnostics=diagnostics)
 
 
 LAWS.register(Moreau())

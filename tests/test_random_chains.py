@@ -165,6 +165,8 @@ def test_random_chains_are_deterministic(seed):
     """The same problem twice gives bit-identical outcomes for every law."""
     _, problem = random_chain(seed)
     for law in lawbench.LAWS:
+        if problem.m > 1 and not law.capabilities.several_contacts:
+            continue
         first, second = law.resolve(problem), law.resolve(problem)
         assert np.array_equal(first.v_plus, second.v_plus), law.name
         assert np.array_equal(first.Pn, second.Pn), law.name
