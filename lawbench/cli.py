@@ -1,7 +1,8 @@
 """The ``lawbench`` command line.
 
 Exit codes: 0 done; 2 bad usage or invalid input; 3 the law does not apply; 4 solver failure;
-1 an unexpected internal error. Errors are one line on stderr, never a traceback.
+5 a regression drifted past its baseline; 1 an unexpected internal error. Errors are one line
+on stderr, never a traceback.
 """
 
 from __future__ import annotations
@@ -19,7 +20,12 @@ from lawbench.errors import InvalidProblem, LawbenchError, NotApplicable, Solver
 from lawbench.law import LAWS, Law
 from lawbench.serialize import trial_record
 
-EXIT_CODES = {InvalidProblem: 2, NotApplicable: 3, SolverFailure: 4}
+
+class Drift(LawbenchError):
+    """Outcomes moved past their baseline tolerance."""
+
+
+EXIT_CODES = {InvalidProblem: 2, NotApplicable: 3, SolverFailure: 4, LawbenchError: 5}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -133,6 +139,76 @@ def _table(args: argparse.Namespace) -> None:
         print(f"table written to {path}")
 
 
+def _run(args: argparse.Namespace) -> None:
+    from lawbench.grid import RunSpec
+    from lawbench.runner import run
+
+    spec = RunSpec.from_toml(Path(args.spec)) if args.spec else None
+    inline = _inline_spec(args)
+    if spec is None and inline is None:
+        raise InvalidProblem("run: give a spec file or --laws/--cases/--param")
+    spec = inline if spec is None else spec
+    out = Path(args.out or ("results." + args.format))
+    table, computed = run(
+        spec,
+        out,
+        args.executor,
+        args.address,
+        args.resume,
+        args.format,
+        args.chunk_size,
+        args.workers,
+    )
+    failed = int((table["error_class"].fillna("") != "").sum()) if len(table) else 0
+    print(f"{len(table)} rows in {out} ({computed} computed now, {failed} failed)")
+
+
+def _inline_spec(args: argparse.Namespace) -> object:
+    from lawbench.grid import RunSpec
+
+    if not (args.laws or args.cases or args.param):
+        return None
+    params = {}
+    for item in args.param:
+        name, _, text = item.partition("=")
+        if not _ or not name:
+            raise InvalidProblem(f"--param {item!r}: expected NAME=VALUE|VALUE|...")
+        params[name] = [_value(v) for v in text.split("|")]
+    grid = {
+        "laws": args.laws.split(",") if args.laws else ["*"],
+        "cases": args.cases.split(",") if args.cases else ["*"],
+        "params": params,
+    }
+    return RunSpec.from_dict({"grid": [grid], "seed": args.seed})
+
+
+def _value(text: str) -> object:
+    """A grid value typed on the command line: a number, a comma list, or a word."""
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        numbers = [float(p) for p in parts]
+    except ValueError:
+        return text.strip()
+    return numbers if len(parts) > 1 else numbers[0]
+
+
+def _regress(args: argparse.Namespace) -> None:
+    from lawbench.baselines import regress
+
+    laws = args.laws.split(",") if args.laws else None
+    cases = args.cases.split(",") if args.cases else None
+    drift = regress(laws, cases, update=args.update)
+    if args.update:
+        print(f"baselines rewritten; {len(drift)} quantities changed")
+        if len(drift):
+            print(drift.to_string(index=False))
+        return
+    if len(drift):
+        print(drift.to_string(index=False))
+        raise Drift(f"regress: {len(drift)} quantities drifted past their tolerance")
+    print("regress: every law holds its baseline")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lawbench`` command."""
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
@@ -163,6 +239,31 @@ def build_parser() -> argparse.ArgumentParser:
     table.add_argument("name", help="rocking_block or sphere_wall")
     table.add_argument("--out", metavar="FILE", help="write the table as CSV to FILE")
     table.set_defaults(run=_table)
+    run = commands.add_parser("run", help="run a grid of laws x cases x parameters")
+    run.add_argument("spec", nargs="?", help="a TOML run specification")
+    run.add_argument("--laws", help="comma-separated laws (default: every law that applies)")
+    run.add_argument("--cases", help="comma-separated cases (default: every case)")
+    run.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=V1|V2",
+        help="grid values of a case parameter; '|' separates values",
+    )
+    run.add_argument("--seed", type=int, default=0, help="seed of random samples")
+    run.add_argument("--out", help="output file (default results.parquet)")
+    run.add_argument("--format", choices=("parquet", "csv"), default="parquet")
+    run.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes")
+    run.add_argument("--address", help="address of a Dask scheduler (default: a local cluster)")
+    run.add_argument("--workers", type=int, help="worker processes (default: one per core)")
+    run.add_argument("--resume", action="store_true", help="compute only the missing rows")
+    run.add_argument("--chunk-size", type=int, default=50, help="rows written per chunk file")
+    run.set_defaults(run=_run)
+    regress = commands.add_parser("regress", help="compare every law with its baseline")
+    regress.add_argument("--update", action="store_true", help="rewrite the baselines")
+    regress.add_argument("--laws", help="comma-separated laws")
+    regress.add_argument("--cases", help="comma-separated cases")
+    regress.set_defaults(run=_regress)
     return parser
 
 
@@ -179,6 +280,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
     except BrokenPipeError:
         return 0
+    except KeyboardInterrupt:
+        print(
+            "lawbench: interrupted; finished rows are kept (rerun with --resume)", file=sys.stderr
+        )
+        return 130
     except Exception as exc:  # a bug: still one line, never a traceback
         print(f"lawbench: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
         return 1

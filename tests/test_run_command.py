@@ -1,0 +1,93 @@
+"""The run and regress commands, as a user calls them: real subprocesses and signals."""
+
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import pandas as pd
+import pytest
+
+SPEC = """
+[[grid]]
+laws = ["compliant"]
+cases = ["three_ball_chain"]
+params = { stiffness_ratio = { logrange = [-2, 2, 40] }, e = [1.0] }
+"""
+
+
+def lawbench(*args, cwd):
+    return subprocess.run(
+        [sys.executable, "-m", "lawbench", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+
+
+def computed_now(stdout):
+    return int(re.search(r"\((\d+) computed now", stdout).group(1))
+
+
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGKILL], ids=["ctrl-c", "killed"])
+def test_an_interrupted_run_resumes_to_the_same_table(tmp_path, stop):
+    """Stop a run halfway with a signal; resuming computes only the missing rows and gives
+    the table of an uninterrupted run."""
+    (tmp_path / "spec.toml").write_text(SPEC)
+    args = ["run", "spec.toml", "--executor", "serial", "--chunk-size", "2"]
+    whole = lawbench(*args, "--out", "whole.parquet", cwd=tmp_path)
+    assert whole.returncode == 0, whole.stderr
+    process = subprocess.Popen(
+        [sys.executable, "-m", "lawbench", *args, "--out", "cut.parquet"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    parts = tmp_path / "cut.parquet.parts"
+    deadline = time.monotonic() + 120
+    while len(list(parts.glob("part-*.parquet"))) < 3 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(stop)
+    _, stderr = process.communicate(timeout=60)
+    assert "Traceback" not in stderr
+    finished = sum(len(pd.read_parquet(p)) for p in parts.glob("part-*.parquet"))
+    assert 0 < finished < 40
+    resumed = lawbench(*args, "--out", "cut.parquet", "--resume", cwd=tmp_path)
+    assert resumed.returncode == 0, resumed.stderr
+    assert computed_now(resumed.stdout) == 40 - finished
+    expected = pd.read_parquet(tmp_path / "whole.parquet").drop(columns="wall_time_s")
+    obtained = pd.read_parquet(tmp_path / "cut.parquet").drop(columns="wall_time_s")
+    pd.testing.assert_frame_equal(obtained, expected)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["run", "--laws", "nope"], "unknown law 'nope'"),
+        (["run", "--cases", "three_ball_chain", "--param", "e=3"], r"e\[0\] = 3"),
+        (["run", "bad.toml"], "malformed TOML"),
+        (
+            [
+                "run",
+                "--laws",
+                "newton",
+                "--cases",
+                "three_ball_chain",
+                "--executor",
+                "dask",
+                "--address",
+                "tcp://127.0.0.1:9",
+            ],
+            "cannot be reached",
+        ),
+    ],
+)
+def test_bad_specs_stop_with_one_line(tmp_path, args, message):
+    (tmp_path / "bad.toml").write_text("[[grid]\n")
+    result = lawbench(*args, cwd=tmp_path)
+    assert result.returncode == 2
+    assert len(result.stderr.splitlines()) == 1 and re.search(message, result.stderr)
+    assert not list(tmp_path.glob("results*"))
