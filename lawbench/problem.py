@@ -53,7 +53,7 @@ class Contact:
     damping : float
         Damping coefficient of compliant models.
     tangential_stiffness_ratio : float or None
-        Jia's ratio eta0^2 of tangential to normal stiffness.
+        Jia's ratio eta0^2 = k0 / k' of the normal (compression) to the tangential stiffness.
     """
 
     e: float = 1.0
@@ -185,10 +185,27 @@ class ImpactProblem:
             set_(self, "_cholesky", scipy.linalg.cho_factor(self.M))
         except np.linalg.LinAlgError:
             raise InvalidProblem("M is not positive definite") from None
+        self._check_normals()
         with np.errstate(over="ignore", invalid="ignore"):
             energy = float(self.v @ self.M @ self.v)
         if not math.isfinite(energy):
             raise InvalidProblem(f"v and M give a kinetic energy that overflows ({energy})")
+
+    def _check_normals(self) -> None:
+        """Refuse a contact that no motion can push along its normal (a singular configuration).
+
+        Its normal Delassus entry is then rounding noise (for example a pendulum hanging
+        straight down onto the floor), and every law's impulse would be meaningless.
+        """
+        W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
+        inverse_mass = np.linalg.eigvalsh(self.solve_mass(np.eye(self.n))).max()
+        scale = inverse_mass * float((W**2).sum(axis=0).max())
+        normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
+        for j in np.flatnonzero(normal <= 1e-12 * scale):
+            raise InvalidProblem(
+                f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 Wn[:, {j}]"
+                f" = {normal[j]:.3g}): a singular configuration"
+            )
 
     @property
     def n(self) -> int:

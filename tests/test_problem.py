@@ -130,3 +130,12 @@ def test_select_contacts_keeps_the_chosen_columns():
     assert only.m == 1
     np.testing.assert_array_equal(only.Wn[:, 0], problem.Wn[:, 1])
     assert dataclasses.replace(problem).m == 2
+
+
+def test_a_contact_no_motion_can_push_along_its_normal_is_refused():
+    """A double pendulum hanging straight down with its tip on the floor: the tip cannot move
+    vertically (to first order), so the normal Delassus entry is rounding noise."""
+    with pytest.raises(InvalidProblem, match="singular configuration"):
+        lawbench.CASES.get("double_pendulum").build(angles=[1e-6, 0.0], omegas=[-1.0, 3.0])
+    nearly = lawbench.CASES.get("double_pendulum").build(angles=[1e-3, 0.0], omegas=[-1.0, 3.0])
+    assert nearly.delassus[0, 0] > 0

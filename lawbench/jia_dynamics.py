@@ -1,0 +1,394 @@
+"""Impulse dynamics of Jia's compliant contacts: normal springs, one tangential spring.
+
+Normal springs (Jia, Mason and Erdmann 2013; Jia 2013): contact i is a linear spring
+of stiffness ``k_i`` whose strain energy ``E_i`` changes with its normal impulse ``I_i`` as
+``dE_i/dI_i = -u_i`` (``u_i`` the gap rate, negative while the contact closes) and whose force is
+``F_i = sqrt(2 k_i E_i)``. At every end of compression (``u_i`` turns positive while the spring
+is loaded) the stiffness rises to ``k_i / e_i^2`` with the force unchanged, so ``E_i`` drops to
+``e_i^2 E_i``: ``e_i`` is the energetic coefficient. The stiffness stays as it is when a contact
+returns from restitution to compression, when its spring empties (the contact becomes inactive,
+its impulse frozen) and when it is reactivated (its gap rate turns negative again).
+
+Rigid contacts. With ``e_i = 0`` the stiffness becomes infinite at the end of compression. A
+contact kept loaded by its neighbours can also end compression, empty, and be reactivated
+again and again, its stiffness growing by ``1/e_i^2`` each time: the sequence of states is
+infinite (Jia, Mason and Erdmann, Theorem 4) and tends to a rigid, plastic contact. Both cases
+are treated as that limit: at an end of compression that leaves a contact ``LOCK`` times
+stiffer (in ``k_i G_ii``, its squared frequency) than the softest other loaded spring, or with
+``e_i = 0``, the contact locks: its gap rate is held at zero by the impulse rate the other
+springs require (``G_LL dI_L = -G_LA dI_A``), its remaining energy is lost, and it releases when
+that rate would turn negative (the contact would pull); approached again, it locks again.
+The state sequence of such chains is sensitive: a near-simultaneous release or a grazing
+reactivation can change the answer discontinuously with the tolerance (on random chains of
+10 to 20 balls with e uniform in (0, 1), answers at tolerances 1e-10 to 1e-12 differed by up
+to 2 % of the largest velocity on some chains and by less than 1e-8 on others).
+
+Tangential spring (Jia 2013), at a single contact only: a massless particle
+joined to the body by the normal spring and by tangential springs of stiffness ``k'``, with
+``eta0^2 = k_0 / k'`` (``k_0`` the normal stiffness in compression). Writing ``s`` for the
+stretch of the tangential springs, ``F_t = -k' s``. The particle sticks (``ds/dt = ut``) while
+the tangential strain energy ``E_t = k' |s|^2 / 2`` stays below ``mu^2 eta^2 E_n``
+(``eta^2 = k / k'``, k the current normal stiffness), which is Coulomb's ``|F_t| <= mu F_n``;
+otherwise it slips with ``|F_t| = mu F_n`` and ``s`` along the slip velocity ``ut - ds/dt``.
+Slip turns to stick when the slip velocity vanishes, stick to slip when ``E_t`` reaches the
+bound. At the start the contact slips when ``|ut-| > mu eta0^2 |un-|`` (the talk's appendix 1).
+The springs hold no energy at the end (the bound vanishes with ``E_n``), except after a plastic
+end of compression, where what the tangential springs hold is lost with the impact's end.
+
+Jia writes these equations in the normal impulse; they are 0/0 where ``E_n`` vanishes, at the
+start and at the end. They are integrated here along ``tau = sqrt(2 k_ref) t``, with
+``y_i = sqrt(E_i)``, ``kappa_i = k_i / k_ref`` and ``g = sqrt(2 k_0) s`` (Jia's G), where they
+are regular (multiplied by ``dI_n/dtau``)::
+
+    dI_i/dtau = sqrt(kappa_i) y_i          dy_i/dtau = -sqrt(kappa_i) u_i / 2
+    stick: dI_t/dtau = -g / (2 eta0^2)     dg/dtau = ut
+    slip:  dI_t/dtau = -mu dI_n/dtau ghat  dg/dtau = rho ghat + ut - (ut . ghat) ghat
+
+with ``rho = -mu kappa eta0^2 un`` (the rate of ``|g|`` that keeps ``|F_t| = mu F_n``),
+``E_t = |g|^2 / (4 eta0^2)`` and the stick bound ``|g| <= 2 mu eta0^2 sqrt(kappa) y``. Every
+transition is an event of scipy's ``solve_ivp`` (DOP853); the contact velocity is affine in the
+impulses, ``u = u- + G [I_n, I_t]`` with ``G`` the contact Delassus matrix.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from lawbench.errors import SolverFailure
+
+# Gap rates above -max(ROUNDING, 100 tolerance) |u-| count as not approaching: a grazing
+# contact is not reactivated by the integration's noise.
+ROUNDING = 1e-12
+# Events closer than this fraction of the time scale happen together.
+SIMULTANEOUS = 1e-9
+MAX_SEGMENTS = 10_000
+# A contact this much stiffer than the softest other loaded spring is rigid (see above).
+LOCK = 1e6
+# A segment with no event within this many natural periods does not end.
+PERIODS = 1e4
+SAMPLES = 33
+
+
+@dataclass(frozen=True)
+class Springs:
+    """Spring parameters of the contacts.
+
+    Attributes
+    ----------
+    kappa : array (m,)
+        Normal stiffness of each contact over a common reference (only ratios matter).
+    e : array (m,)
+        Energetic restitution coefficients.
+    mu : float
+        Coulomb coefficient of the single contact with a tangential spring (0: none).
+    eta0_sq : float
+        Jia's ratio ``eta0^2`` of normal (compression) to tangential stiffness.
+    """
+
+    kappa: np.ndarray
+    e: np.ndarray
+    mu: float = 0.0
+    eta0_sq: float = 1.0
+
+
+@dataclass
+class Record:
+    """What happened: events, state or mode sequence, solver steps, energies, path samples."""
+
+    events: list[dict] = field(default_factory=list)
+    sequence: list[str] = field(default_factory=list)
+    steps: int = 0
+    compression_loss: float = 0.0
+    samples: list[np.ndarray] = field(default_factory=list)
+
+
+class SpringImpact:
+    """Jia's springs from first touch until no contact is loaded and none approaches.
+
+    Parameters
+    ----------
+    G : array (m + d, m + d)
+        Contact Delassus matrix, the m normal rows first, then the d tangential rows of the
+        single contact with a tangential spring (d = 0: frictionless).
+    u_minus : array (m + d,)
+        Pre-impact contact velocities.
+    springs : Springs
+        Stiffness ratios, restitution, friction.
+    tolerance : float
+        Relative tolerance of the integration.
+    keep_path : bool
+        Whether to sample the impulse curve.
+    """
+
+    def __init__(
+        self,
+        G: np.ndarray,
+        u_minus: np.ndarray,
+        springs: Springs,
+        tolerance: float,
+        keep_path: bool,
+    ) -> None:
+        self.G, self.u_minus, self.springs = G, u_minus, springs
+        self.m = len(springs.kappa)
+        self.d = G.shape[0] - self.m
+        self.tolerance, self.keep_path = tolerance, keep_path
+        self.kappa = springs.kappa.astype(float).copy()
+        self.approach = max(ROUNDING, 100 * tolerance) * float(np.abs(u_minus).max())
+        self.active = u_minus[: self.m] < -self.approach
+        self.compressing = self.active.copy()
+        # Rigid contacts: locked (holding the gap rate), or rigid but released.
+        self.rigid = np.zeros(self.m, dtype=bool)
+        self.locked = np.zeros(self.m, dtype=bool)
+        # An inactive contact is reactivated when its gap rate falls below its floor.
+        self.floor = np.full(self.m, -self.approach)
+        self.lock = np.zeros((0, self.m))
+        self.record = Record()
+        self.stick = True
+        self.direction = np.zeros(self.d)
+        if self.d:
+            ut, un = u_minus[self.m :], u_minus[0]
+            # The contact starts slipping when |ut| > mu eta0^2 |un| (talk, appendix 1).
+            if np.linalg.norm(ut) > springs.mu * springs.eta0_sq * self.kappa[0] * -un:
+                self.stick = False
+                self.direction = ut / np.linalg.norm(ut)
+        diag = np.diag(G)[: self.m] * self.kappa
+        frequency = math.sqrt(float(diag.min()) / 2.0)
+        self.time_scale = 2.0 * math.pi / frequency
+        impulse = float(np.abs(u_minus).max()) / float(np.diag(G)[: self.m].min())
+        rate = float(np.abs(u_minus).max())
+        self.scale = np.concatenate(
+            [
+                np.full(self.m, impulse),
+                np.full(self.m, math.sqrt(impulse * rate)),
+                np.full(self.d, impulse),
+                np.full(self.d, rate * self.time_scale),
+            ]
+        )
+
+    # --- the equations --------------------------------------------------------------------------
+
+    def velocity(self, s: np.ndarray) -> np.ndarray:
+        """Contact velocities at state ``s``."""
+        impulses = np.concatenate([s[: self.m], s[2 * self.m : 2 * self.m + self.d]])
+        return self.u_minus + self.G @ impulses
+
+    def _ghat(self, g: np.ndarray) -> np.ndarray:
+        norm = np.linalg.norm(g)
+        return g / norm if norm > 0 else self.direction
+
+    def _rate(self, tau: float, s: np.ndarray) -> np.ndarray:
+        m, d, springs = self.m, self.d, self.springs
+        u = self.velocity(s)
+        root = np.sqrt(self.kappa) * self.active
+        rate = np.empty_like(s)
+        rate[:m] = root * s[m : 2 * m]
+        rate[m : 2 * m] = -root * u[:m] / 2.0
+        if self.locked.any():
+            rate[:m][self.locked] = self.lock @ rate[:m]
+        if d:
+            g, ut = s[2 * m + d :], u[m:]
+            if self.stick:
+                rate[2 * m : 2 * m + d] = -g / (2.0 * springs.eta0_sq)
+                rate[2 * m + d :] = ut
+            else:
+                ghat = self._ghat(g)
+                rho = -springs.mu * self.kappa[0] * springs.eta0_sq * u[0]
+                rate[2 * m : 2 * m + d] = -springs.mu * rate[0] * ghat
+                rate[2 * m + d :] = rho * ghat + ut - (ut @ ghat) * ghat
+        return rate
+
+    def _lock_map(self) -> np.ndarray:
+        """Matrix (locked, m) from the springs' impulse rates to the locked contacts' ones.
+
+        The locked rates keep the locked gap rates constant: ``G_LL dI_L = -G_LA dI_A``.
+        """
+        L, A = self.locked, self.active
+        Gnn = self.G[: self.m, : self.m]
+        lock = np.zeros((int(L.sum()), self.m))
+        lock[:, A] = -np.linalg.lstsq(Gnn[np.ix_(L, L)], Gnn[np.ix_(L, A)], rcond=None)[0]
+        return lock
+
+    def _spring_rate(self, s: np.ndarray) -> np.ndarray:
+        return np.sqrt(self.kappa) * self.active * s[self.m : 2 * self.m]
+
+    def _locked_force(self, s: np.ndarray, row: int) -> float:
+        return float(self.lock[row] @ self._spring_rate(s))
+
+    def _stick_margin(self, s: np.ndarray) -> float:
+        """``|g|`` minus the stick bound: positive once the spring force exceeds mu F_n."""
+        m, springs = self.m, self.springs
+        bound = 2.0 * springs.mu * springs.eta0_sq * math.sqrt(self.kappa[0]) * s[m]
+        return float(np.linalg.norm(s[2 * m + self.d :])) - bound
+
+    def _slip_speed(self, s: np.ndarray) -> float:
+        """Slip velocity along the spring: ``ut . ghat - d|g|/dtau``; zero when slip stops."""
+        u = self.velocity(s)
+        ghat = self._ghat(s[2 * self.m + self.d :])
+        springs = self.springs
+        return float(u[self.m :] @ ghat) + springs.mu * self.kappa[0] * springs.eta0_sq * u[0]
+
+    def _gap_rate(self, s: np.ndarray, j: int) -> float:
+        return float(self.velocity(s)[j])
+
+    def _approach(self, s: np.ndarray, j: int) -> float:
+        return float(self.velocity(s)[j]) - self.floor[j]
+
+    def _spring(self, s: np.ndarray, j: int) -> float:
+        return float(s[self.m + j])
+
+    def _events(self) -> list:
+        """The armed events; each starts on its quiet side, so none fires at its own start."""
+        armed: list[tuple[str, int, Callable, int]] = []
+        rows = np.cumsum(self.locked) - 1
+        for j in range(self.m):
+            if self.locked[j]:
+                armed.append(("release", j, partial(self._locked_force, row=rows[j]), -1))
+            elif not self.active[j]:
+                armed.append(("reactivation", j, partial(self._approach, j=j), -1))
+            elif self.compressing[j]:
+                armed.append(("end of compression", j, partial(self._gap_rate, j=j), 1))
+            else:
+                armed.append(("recompression", j, partial(self._gap_rate, j=j), -1))
+                armed.append(("separation", j, partial(self._spring, j=j), -1))
+        if self.d and self.active[0]:
+            if self.stick:
+                armed.append(("slip", 0, self._stick_margin, 1))
+            else:
+                armed.append(("stick", 0, self._slip_speed, -1))
+        return [_event(*entry) for entry in armed]
+
+    # --- the run --------------------------------------------------------------------------------
+
+    def run(self) -> np.ndarray:
+        """Integrate the impact; return the final state ``[I_n, y, I_t, g]``."""
+        tau, s = 0.0, np.zeros(2 * (self.m + self.d))
+        self._note_state(tau, s, ["stick" if self.stick else "slip"] if self.d else [])
+        for _ in range(MAX_SEGMENTS):
+            s = self._settle(s)
+            if not self.active.any():
+                return s
+            events = self._events()
+            solution = solve_ivp(
+                self._rate,
+                (tau, tau + PERIODS * self.time_scale),
+                s,
+                method="DOP853",
+                rtol=self.tolerance,
+                atol=self.tolerance * self.scale,
+                events=events,
+                dense_output=self.keep_path,
+            )
+            if solution.status < 0:
+                raise SolverFailure(f"jia: solve_ivp failed ({solution.message})")
+            self.record.steps += len(solution.t) - 1
+            if self.keep_path:
+                grid = np.linspace(tau, solution.t[-1], SAMPLES)
+                self.record.samples.append(np.vstack([grid, solution.sol(grid)]).T)
+            if solution.status == 0:
+                raise SolverFailure(
+                    f"jia: no contact event within {PERIODS:g} natural periods: the impact "
+                    "does not end"
+                )
+            tau, s = float(solution.t[-1]), solution.y[:, -1].copy()
+            fired = [
+                event.label
+                for event, times in zip(events, solution.t_events, strict=True)
+                if times.size and abs(times[-1] - tau) <= SIMULTANEOUS * self.time_scale
+            ]
+            for name, j in fired:
+                s = self._apply(name, j, s)
+            self._note_state(tau, s, [name for name, _ in fired])
+        raise SolverFailure(f"jia: the impact did not end within {MAX_SEGMENTS} transitions")
+
+    def _settle(self, s: np.ndarray) -> np.ndarray:
+        """Reactivate the contacts that approach, release the locked ones that would pull."""
+        approaching = ~self.active & ~self.locked
+        approaching &= self.velocity(s)[: self.m] < self.floor
+        for j in np.flatnonzero(approaching):
+            s = self._apply("reactivation", int(j), s)
+        for _ in range(self.m + 1):
+            self.lock = self._lock_map()
+            if not self.locked.any():
+                break
+            spring_rate = self._spring_rate(s)
+            rates = self.lock @ spring_rate
+            if rates.min() >= -ROUNDING * float(np.abs(spring_rate).max(initial=0.0)):
+                break
+            s = self._apply("release", int(np.flatnonzero(self.locked)[np.argmin(rates)]), s)
+        return s
+
+    def _stiffest_ratio(self, j: int) -> float:
+        """Squared frequency of contact j over that of the softest other loaded spring."""
+        frequency = self.kappa * np.diag(self.G)[: self.m]
+        others = self.active.copy()
+        others[j] = False
+        return float(frequency[j] / frequency[others].min()) if others.any() else 0.0
+
+    def _apply(self, name: str, j: int, s: np.ndarray) -> np.ndarray:
+        """Change the contact state for the event ``name`` at contact ``j``."""
+        m, y = self.m, s[self.m + j]
+        if name == "end of compression":
+            e = self.springs.e[j]
+            self.compressing[j] = False
+            if e > 0:
+                self.kappa[j] /= e * e
+            if e == 0 or self._stiffest_ratio(j) > LOCK:
+                self.record.compression_loss += float(y * y)
+                self.active[j], self.rigid[j], self.locked[j], s[m + j] = False, True, True, 0.0
+            else:
+                self.record.compression_loss += float((1.0 - e * e) * y * y)
+                s[m + j] = e * y
+        elif name == "recompression":
+            self.compressing[j] = True
+        elif name == "separation":
+            self.active[j], self.compressing[j], s[m + j] = False, False, 0.0
+        elif name == "release":
+            # Held at its gap rate, it may sit at the threshold: reactivate only below it.
+            self.locked[j] = False
+            self.floor[j] = min(float(self.velocity(s)[j]), 0.0) - self.approach
+        elif name == "reactivation":
+            self.floor[j] = -self.approach
+            if self.rigid[j]:
+                self.locked[j] = True
+            else:
+                self.active[j], self.compressing[j] = True, True
+        elif name == "slip":
+            self.stick = False
+            self.direction = self._ghat(s[2 * m + self.d :])
+        else:
+            self.stick = True
+        return s
+
+    def _note_state(self, tau: float, s: np.ndarray, fired: list[str]) -> None:
+        """Record the events at ``tau`` and the state (several contacts) or mode that follows."""
+        self.record.events.append({"tau": tau, "events": fired, "Pn": s[: self.m].tolist()})
+        if self.m > 1 or not self.d:
+            active = [str(j) for j in np.flatnonzero(self.active)]
+            active += [f"{j} locked" for j in np.flatnonzero(self.locked)]
+            labels = ["{" + ", ".join(active) + "}" if self.active.any() else "end of impact"]
+        else:
+            labels = [_PHASE_NAMES.get(name, name) for name in fired]
+            if not self.active[0]:
+                labels = [*(x for x in labels if x not in ("stick", "slip")), "end of impact"]
+        for label in labels:
+            if not self.record.sequence or self.record.sequence[-1] != label:
+                self.record.sequence.append(label)
+
+
+_PHASE_NAMES = {"separation": "end of impact"}
+
+
+def _event(name: str, j: int, function: Callable, direction: int) -> Callable:
+    """A terminal ``solve_ivp`` event named ``(name, j)`` on ``function(state)``."""
+
+    def event(tau: float, s: np.ndarray) -> float:
+        return function(s)
+
+    event.terminal, event.direction, event.label = True, direction, (name, j)
+    return event

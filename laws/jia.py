@@ -1,0 +1,209 @@
+"""Jia's laws: energy-based tangential compliance at one contact, state transitions at several.
+
+Source: Y.-B. Jia, *Three-dimensional impact: energy-based modeling of tangential compliance*,
+Int. J. Robotics Research 32(1), 2013, and Y.-B. Jia, M. T. Mason, M. A. Erdmann, *Multiple
+impacts: a state transition diagram approach*, IJRR 32(1), 2013, as presented in Jia's talk
+*Simultaneous three-dimensional impacts with friction and compliance* (2012). The equations and
+their integration are in `lawbench.jia_dynamics`.
+
+- One contact: the contact point is a massless particle held by a normal spring and two
+  tangential springs. The normal impulse drives the impact: the normal strain energy obeys
+  ``dE_n/dI_n = -un``, the tangential impulse ``dI_t/dI_n = F_t / F_n`` follows from the spring
+  energies, and the contact sticks while ``E_t < mu^2 eta^2 E_n`` (Coulomb's bound on the
+  spring force), slips otherwise. At the end of compression the normal stiffness rises from
+  ``k_0`` to ``k_0 / e^2`` with the force unchanged, so the spring keeps ``e^2`` of its energy:
+  ``e`` is the energetic coefficient (``contact.restitution('energy')``). The tangential
+  stiffness ``k'`` never changes; ``eta0^2 = k_0 / k'`` is the contact's
+  ``tangential_stiffness_ratio``. When it is None the law takes Mindlin's ratio for identical
+  elastic bodies with Poisson's ratio 0.3, ``(2 - nu) / (2 (1 - nu)) = 17/14`` (Jia's bouncing
+  ball; the talk rounds it to 1.2). The impact ends when the normal spring is empty again.
+- Several contacts (Jia, Mason and Erdmann): every contact is a linear normal spring with the
+  same stiffness increase at each of its ends of compression; a contact whose spring empties
+  leaves the active set, and returns when its gap rate turns negative (no stiffness change on
+  either event). The outcome depends on stiffness ratios only, taken from the contacts'
+  ``stiffness``; the springs are linear, the contacts' ``exponent`` is not read. The law treats
+  frictionless chains of balls on a line (the ball on a ball on the ground of the paper, the
+  two-ball wall scene, ball chains) and refuses other problems with several contacts. No time
+  passes within the impact: a reactivated contact ignores the gap it opened, so where a
+  contact opens and closes again the outcome differs from the same springs integrated in time.
+- Both: the stiffness rises at every end of compression, a second one after a return from
+  restitution to compression included (the talk: "every end of compression of single
+  impact"). A plastic contact (e = 0) becomes infinitely stiff: at one contact the impact ends
+  with the compression (what the tangential springs hold is lost). In a chain, a contact held
+  loaded by its neighbours can end compression, empty and return without end, its stiffness
+  growing each time; that infinite sequence, and e = 0, are treated as their limit, a rigid
+  plastic contact that holds its gap rate while it pushes (`lawbench.jia_dynamics`, LOCK).
+
+Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart; ``Pt`` is the tangential impulse
+in the columns of ``Wt`` (``|Pt| <= mu Pn`` holds along the whole impact, and ``Pt`` opposes
+the particle's slip); ``v+ = v- + M^-1 (Wn Pn + Wt Pt)``. A closed contact that separates before
+the impact is inactive until its gap rate turns negative.
+
+Formulations (``diagnostics['formulation']``): frictionless with a diagonal Delassus matrix (one
+contact included), the closed form ``Pn = -(1 + e) un- / G_jj`` (the energetic coefficient
+equals Newton's there); otherwise the spring equations integrated with scipy's DOP853 at the
+relative ``tolerance``, every transition (end of compression, slip, stick, separation,
+reactivation, lock, release) an event; a gap rate above ``-100 tolerance |u-|`` does not count
+as approaching. Diagnostics: ``sequence`` (one contact: the modes and events, for
+example slip, stick, end of compression, slip, end of impact; several: the active sets),
+``events`` (each transition with its ``tau`` and normal impulses), ``steps`` (integrator
+steps), ``compression_loss`` (J, energy taken at the ends of compression). Option ``path``
+returns the impulse curve: ``tau``, ``Pn`` (k, m), ``Pt`` (k, d), ``En`` (k, m) and ``Et`` (k,)
+the spring energies (J), ``un`` and ``ut`` the contact velocities.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from lawbench.errors import NotApplicable
+from lawbench.jia_dynamics import SpringImpact, Springs
+from lawbench.law import LAWS, Capabilities, Law
+from lawbench.mechanics import is_diagonal
+from lawbench.outcome import Outcome
+from lawbench.problem import ImpactProblem
+from lawbench.spec import Spec
+
+POISSON_RATIO = 0.3
+DEFAULT_TANGENTIAL_STIFFNESS_RATIO = (2 - POISSON_RATIO) / (2 * (1 - POISSON_RATIO))
+APPROACH = 1e-12
+
+
+class Jia(Law):
+    """Jia's tangential compliance (one contact) and state transitions (frictionless chains)."""
+
+    name = "jia"
+    summary = (
+        "Jia's energy-based tangential compliance at one contact; Jia-Mason-Erdmann state "
+        "transitions for frictionless chains"
+    )
+    source = (
+        "Jia, IJRR 32(1) 2013 (tangential compliance); Jia, Mason and Erdmann, IJRR 32(1) 2013 "
+        "(multiple impacts)"
+    )
+    capabilities = Capabilities(
+        friction=True,
+        several_contacts=True,
+        spatial=True,
+        needs_stiffness=True,
+        accuracy_knob="tolerance",
+    )
+    options = (
+        Spec(
+            "tolerance",
+            1e-11,
+            "relative tolerance of the integration along the impact",
+            "",
+            "float",
+            0.0,
+            1e-2,
+            low_open=True,
+        ),
+        Spec(
+            "path",
+            False,
+            "return the impulse curve (impulses, spring energies, contact velocities)",
+            "",
+            "bool",
+        ),
+    )
+
+    def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        if problem.m > 1:
+            _check_chain(problem)
+        d = problem.d if problem.frictional else 0
+        un = problem.un
+        if not (un < -APPROACH * np.abs(np.concatenate([un, problem.ut])).max()).any():
+            diagnostics = {"formulation": "no approaching contact", "sequence": [], "steps": 0}
+            return Outcome.from_impulses(problem, np.zeros(problem.m), diagnostics=diagnostics)
+        e = problem.restitution("energy")
+        if not d and is_diagonal(problem.delassus) and not options["path"]:
+            Pn = np.where(un < 0, -(1 + e) * un / np.diag(problem.delassus), 0.0)
+            formulation = "closed form" if problem.m == 1 else "decoupled (diagonal Delassus)"
+            diagnostics = {"formulation": formulation, "sequence": [], "steps": 0}
+            return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
+        return _integrate(problem, d, e, options)
+
+
+def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str, Any]) -> Outcome:
+    """Integrate Jia's springs; ``d`` tangential directions at the single contact (0: none)."""
+    m = problem.m
+    contact = problem.contacts[0]
+    eta0_sq = contact.tangential_stiffness_ratio
+    if eta0_sq is None:
+        eta0_sq = DEFAULT_TANGENTIAL_STIFFNESS_RATIO
+    stiffness = np.array([c.stiffness for c in problem.contacts])
+    springs = Springs(stiffness / stiffness[0], e, contact.mu if d else 0.0, eta0_sq)
+    if d:
+        G, u_minus = problem.contact_delassus, np.concatenate([problem.un, problem.ut])
+    else:
+        G, u_minus = problem.delassus, problem.un
+    impact = SpringImpact(G, u_minus, springs, options["tolerance"], options["path"])
+    state = impact.run()
+    record = impact.record
+    if d:
+        formulation = "tangential compliance, one contact (Jia 2013), integrated"
+    elif m == 1:
+        formulation = "normal spring, one contact (Jia 2013), integrated"
+    else:
+        formulation = "state transitions, frictionless chain (Jia, Mason, Erdmann 2013)"
+    diagnostics = {
+        "formulation": formulation,
+        "sequence": record.sequence,
+        "events": record.events,
+        "steps": record.steps,
+        "compression_loss": record.compression_loss,
+    }
+    if d:
+        diagnostics["tangential_stiffness_ratio"] = eta0_sq
+    if any(c.exponent != 1 for c in problem.contacts) and m > 1:
+        diagnostics["springs"] = "linear: the contacts' exponent is not read"
+    path = _path(impact, eta0_sq) if options["path"] else None
+    Pt = state[2 * m : 2 * m + d] if d else None
+    return Outcome.from_impulses(problem, state[:m], Pt, diagnostics=diagnostics, path=path)
+
+
+def _path(impact: SpringImpact, eta0_sq: float) -> dict[str, np.ndarray]:
+    """The impulse curve from the samples of ``impact``: impulses, energies, velocities."""
+    m, d = impact.m, impact.d
+    samples = np.vstack(impact.record.samples)
+    states = samples[:, 1:]
+    velocities = np.array([impact.velocity(s) for s in states])
+    return {
+        "tau": samples[:, 0],
+        "Pn": states[:, :m],
+        "Pt": states[:, 2 * m : 2 * m + d],
+        "En": states[:, m : 2 * m] ** 2,
+        "Et": np.sum(states[:, 2 * m + d :] ** 2, axis=1) / (4 * eta0_sq),
+        "un": velocities[:, :m],
+        "ut": velocities[:, m:],
+    }
+
+
+def _check_chain(problem: ImpactProblem) -> None:
+    """Raise `NotApplicable` unless the problem is a frictionless chain of balls on a line."""
+    reason = None
+    if problem.frictional:
+        reason = "it has friction, and the state-transition model is frictionless"
+    elif np.any(problem.M - np.diag(np.diag(problem.M))):
+        reason = "its mass matrix is not diagonal (not balls on a line)"
+    else:
+        for j, column in enumerate(problem.Wn.T):
+            entries = column[column != 0]
+            if not (
+                len(entries) in (1, 2)
+                and np.all(np.abs(entries) == 1)
+                and (len(entries) == 1 or entries.sum() == 0)
+            ):
+                reason = f"contact {j} does not join two balls on a line, or a ball and a wall"
+                break
+    if reason:
+        raise NotApplicable(
+            "jia: with several contacts the law is Jia, Mason and Erdmann's state-transition "
+            f"model of frictionless chains of balls (a ball on a ball on the ground); here {reason}"
+        )
+
+
+LAWS.register(Jia())
