@@ -15,10 +15,11 @@ from lawbench.problem import Contact, ImpactProblem
 SEEDS = range(40)
 
 
-def random_chain(seed, approaching=False, single_e=False):
-    """A random chain problem; ``approaching`` makes every contact close (v non-increasing)."""
+def random_chain(seed, approaching=False, single_e=False, most=20):
+    """A random chain problem of at most ``most`` balls; ``approaching`` makes every contact
+    close (v non-increasing)."""
     rng = np.random.default_rng(seed)
-    n = int(rng.integers(2, 21))
+    n = int(rng.integers(2, most + 1))
     wall = bool(rng.integers(2))
     params = {
         "n": n,
@@ -162,11 +163,22 @@ def test_poisson_equals_newton_on_one_contact(seed):
 
 @pytest.mark.parametrize("seed", range(10))
 def test_random_chains_are_deterministic(seed):
-    """The same problem twice gives bit-identical outcomes for every law."""
-    _, problem = random_chain(seed)
+    """The same problem twice gives bit-identical outcomes for every law (short chains, so
+    that the integrated laws stay within their budgets)."""
+    _, problem = random_chain(seed, most=5)
     for law in lawbench.LAWS:
         if problem.m > 1 and not law.capabilities.several_contacts:
             continue
+        if law.name == "lzb":
+            continue  # dissipative chains cost it tens of seconds: see its own test below
         first, second = law.resolve(problem), law.resolve(problem)
         assert np.array_equal(first.v_plus, second.v_plus), law.name
         assert np.array_equal(first.Pn, second.Pn), law.name
+
+
+def test_lzb_is_deterministic():
+    problem = lawbench.CASES.get("three_ball_chain").build(e=0.8, stiffness_ratio=3.0)
+    law = lawbench.LAWS.get("lzb")
+    first, second = law.resolve(problem), law.resolve(problem)
+    assert np.array_equal(first.v_plus, second.v_plus)
+    assert np.array_equal(first.Pn, second.Pn)
