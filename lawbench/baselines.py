@@ -67,6 +67,8 @@ def _vector(text: str) -> np.ndarray | None:
 def _difference(base: np.ndarray | None, new: np.ndarray | None) -> float:
     if base is None or new is None or base.shape != new.shape:
         return 0.0 if base is None and new is None else np.inf
+    if base.size == 0:
+        return 0.0
     return float(np.abs(new - base).max() / max(1.0, np.abs(base).max()))
 
 
