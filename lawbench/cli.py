@@ -122,7 +122,7 @@ def _solve(args: argparse.Namespace) -> None:
 def _report(args: argparse.Namespace) -> None:
     from lawbench.report import write_report
 
-    path = write_report(Path(args.out))
+    path = write_report(Path(args.out), mode=args.mode)
     print(f"report written to {path}")
 
 
@@ -234,6 +234,22 @@ def build_parser() -> argparse.ArgumentParser:
     solve.set_defaults(run=_solve)
     report = commands.add_parser("report", help="write the comparison report")
     report.add_argument("--out", default="reports/latest", help="output folder")
+    size = report.add_mutually_exclusive_group()
+    size.add_argument(
+        "--quick",
+        dest="mode",
+        action="store_const",
+        const="quick",
+        help="the default: every section, small grids (minutes)",
+    )
+    size.add_argument(
+        "--full",
+        dest="mode",
+        action="store_const",
+        const="full",
+        help="the large grids, through the run machinery (resumable)",
+    )
+    report.set_defaults(mode="quick")
     report.set_defaults(run=_report)
     table = commands.add_parser("table", help="tabulate a study of several laws (CSV)")
     table.add_argument("name", help="rocking_block or sphere_wall")

@@ -33,6 +33,7 @@ import numpy as np
 import scipy.integrate
 import scipy.optimize
 
+from lawbench import budget
 from lawbench.errors import SolverFailure
 from lawbench.problem import ImpactProblem
 
@@ -114,6 +115,8 @@ class EnergeticImpact:
         scipy ``OdeSolver`` class name.
     max_steps, max_events : int
         Budgets of integrator steps and of restarts at events.
+    max_seconds : float
+        Wall-clock budget.
     record_path : bool
         Keep the states along the impact.
     """
@@ -126,8 +129,10 @@ class EnergeticImpact:
         method: str,
         max_steps: int,
         max_events: int,
+        max_seconds: float,
         record_path: bool,
     ) -> None:
+        self.deadline = budget.Deadline("lzb", max_seconds)
         self.problem, self.variant, self.rtol = problem, variant, rtol
         self.method = getattr(scipy.integrate, method)
         self.max_steps, self.max_events, self.record_path = max_steps, max_events, record_path
@@ -415,6 +420,7 @@ class EnergeticImpact:
         kind = "time" if seg.primary < 0 else "impulse"
         before = self.switching(y, seg)
         while True:
+            self.deadline.check()
             if sum(self.steps.values()) >= self.max_steps:
                 raise SolverFailure(
                     f"lzb: integrator step budget ran out ({self.max_steps} steps, max_steps)"

@@ -77,21 +77,32 @@ class LCPResult:
 def polish(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> np.ndarray | None:
     """Solve the active set of an approximate LCP solution exactly.
 
-    The active set is where ``z`` exceeds the slack ``w``. Returns the exact solution on that
-    set when it is complementary to rounding, else None.
+    Candidate active sets: where ``z`` exceeds the slack ``w``, then where ``z`` is not
+    negligible against its largest entry (badly scaled problems, masses over many decades,
+    leave both ``z`` and ``w`` small). Returns the exact solution on the first set that is
+    complementary to rounding, else None.
     """
     w = G @ z + q
-    active = z > w
+    for active in (z > w, z > 1e-6 * z.max()):
+        exact = _on_active_set(G, q, active)
+        if exact is not None:
+            return exact
+    return None
+
+
+def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarray | None:
     exact = np.zeros_like(q)
     if active.any():
-        block = G[np.ix_(active, active)]
         try:
-            exact[active] = scipy.linalg.solve(block, -q[active], assume_a="pos")
+            exact[active] = scipy.linalg.solve(
+                G[np.ix_(active, active)], -q[active], assume_a="pos"
+            )
         except (np.linalg.LinAlgError, ValueError):
             return None
-    scale = max(np.abs(q).max(), ROUNDING)
     slack = G @ exact + q
-    if exact.min() < -1e-10 * scale or slack.min() < -1e-10 * scale:
+    velocity_scale = max(np.abs(q).max(), ROUNDING)
+    impulse_scale = max(np.abs(exact).max(), ROUNDING)
+    if exact.min() < -1e-10 * impulse_scale or slack.min() < -1e-10 * velocity_scale:
         return None
     return np.maximum(exact, 0.0)
 

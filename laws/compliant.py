@@ -34,7 +34,8 @@ times 1e-3 in scaled units). Order of convergence: the error of ``v_plus`` again
 tight-tolerance reference falls in proportion to rtol (slope 1 in log-log; on the three-ball
 chain it stays between 0.01 and 0.2 times rtol from 1e-3 to 1e-10, tested), while DOP853's
 step count grows only as about rtol^(-1/8). Budgets: ``max_steps`` solver steps and
-``max_events`` restarts, each raising `SolverFailure` naming what ran out.
+``max_events`` restarts and ``max_seconds`` of wall-clock time, each raising `SolverFailure`
+naming what ran out.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ import numpy as np
 import scipy.integrate
 import scipy.optimize
 
+from lawbench import budget
 from lawbench.errors import NotApplicable, SolverFailure
 from lawbench.law import LAWS, Capabilities, Law
 from lawbench.outcome import Outcome
@@ -77,11 +79,20 @@ def kelvin_voigt_restitution(ratio: float, termination: str) -> float:
 
 
 def _kelvin_voigt_ratio(e: float, termination: str) -> float:
-    """The damping ratio whose Kelvin-Voigt restitution coefficient is ``e``."""
+    """The damping ratio whose Kelvin-Voigt restitution coefficient is ``e``.
+
+    Raises `NotApplicable` for the coefficients no underdamped contact reaches: ``e = 0`` (at
+    critical damping the gap never reopens) and, when the contact ends as its force returns to
+    zero, ``e < exp(-2)`` (the limit of that closed form as the ratio tends to 1).
+    """
     if e >= 1.0:
         return 0.0
-    if e <= 0.0:
-        return 1.0
+    lowest = 0.0 if termination == "gap" else math.exp(-2.0)
+    if e <= lowest:
+        raise NotApplicable(
+            f"compliant: a Kelvin-Voigt contact ending at {termination} reaches only "
+            f"e > {lowest:.4g} when underdamped; e = {e:g} is out of its reach"
+        )
     return scipy.optimize.brentq(
         lambda z: kelvin_voigt_restitution(z, termination) - e, 0.0, 1.0 - 1e-15, xtol=1e-15
     )
@@ -124,6 +135,7 @@ class Compliant(Law):
         Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
         Spec("max_events", 100_000, "budget of restarts at contact events", "", "int", 1),
         Spec("path", False, "return time histories of forces and stored energies", "", "bool"),
+        budget.OPTION,
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
@@ -230,7 +242,9 @@ class _Integration:
         peak = np.zeros(problem.m)
         history: list[tuple[float, np.ndarray]] = [(0.0, y)]
         solver = method(self.rhs, t, y, np.inf, rtol=rtol, atol=rtol * 1e-3)
+        deadline = budget.Deadline("compliant", options["max_seconds"])
         while not self.ended(y):
+            deadline.check()
             if steps == options["max_steps"]:
                 raise SolverFailure(
                     f"compliant: integrator step budget ran out ({steps} steps, max_steps)"

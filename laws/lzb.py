@@ -82,8 +82,8 @@ the plastic outcome of the lectures' "case of large friction".
 Impacts that do not end: energy that can never leave (a rod held at both ends by friction at
 e* = 1, a light ball rattling between heavy ones) or contacts recompressed again and again with
 geometrically smaller energies (long chains with e* < 1, as in an inelastic collapse) make
-many cycles; ``max_steps`` integrator steps and ``max_events`` events bound the run and raise
-`SolverFailure` naming the budget that ran out.
+many cycles; ``max_steps`` integrator steps, ``max_events`` events and ``max_seconds`` of
+wall-clock time bound the run and raise `SolverFailure` naming the budget that ran out.
 
 Conventions: ``un = Wn.T v < 0`` approaches, ``Pn >= 0`` pushes apart,
 ``v+ = v- + M^-1 (Wn Pn + Wt Pt)``, ``|Pt_j| <= mu_j Pn_j``. A closed contact that separates
@@ -114,6 +114,7 @@ from typing import Any
 import numpy as np
 import scipy.special
 
+from lawbench import budget
 from lawbench.law import LAWS, Capabilities, Law
 from lawbench.lzb_dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 from lawbench.mechanics import is_diagonal
@@ -148,6 +149,7 @@ class LiuZhaoBrogliato(Law):
         ),
         Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
         Spec("max_events", 20_000, "budget of restarts at events", "", "int", 1),
+        budget.OPTION,
         Spec(
             "path",
             False,
@@ -173,6 +175,7 @@ class LiuZhaoBrogliato(Law):
             options["method"],
             options["max_steps"],
             options["max_events"],
+            options["max_seconds"],
             options["path"],
         )
         y = impact.run()

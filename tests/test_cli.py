@@ -396,6 +396,7 @@ def test_console_script_reports_bad_input_like_python_m():
 # 6. report
 
 
+@pytest.mark.slow
 def test_report_writes_its_three_files(tmp_path):
     out = tmp_path / "report"
     result = run_lawbench("report", "--out", str(out))

@@ -148,3 +148,36 @@ def test_path_holds_forces_and_stored_energies():
     assert path["force"].shape == (len(path["t"]), 2) == path["stored_energy"].shape
     assert np.all(np.diff(path["t"]) > 0)
     assert path["force"].max() <= max(outcome.diagnostics["peak_force"]) * (1 + 1e-12)
+
+
+def wall_force_period(outcome):
+    """Median time between successive peaks of the wall force (contact 0)."""
+    t, force = outcome.path["t"], outcome.path["force"][:, 0]
+    peaks = [
+        i
+        for i in range(1, len(force) - 1)
+        if force[i] > force[i - 1] and force[i] >= force[i + 1] and force[i] > 0.2 * force.max()
+    ]
+    return float(np.median(np.diff(t[peaks])))
+
+
+@pytest.mark.parametrize(("height", "measured"), [(3.1e-3, 52.0), (5.1e-3, 71.0)])
+def test_bead_column_peak_wall_force_matches_falcon(height, measured):
+    """Falcon et al., Eur. Phys. J. B 5 (1998), as reported in Brogliato 2010: peak wall force
+    52 N (h = 3.1 mm) and 71 N (h = 5.1 mm), nearly independent of the number of beads."""
+    peaks = [
+        lawbench.solve("compliant", "bead_column", n=n, drop_height=height).diagnostics[
+            "peak_force"
+        ][0]
+        for n in (1, 10, 40)
+    ]
+    for peak in peaks:
+        assert peak == pytest.approx(measured, rel=0.15)
+    assert max(peaks) / min(peaks) < 1.05
+
+
+def test_bead_column_wall_force_period_matches_falcon():
+    """The wall force oscillates with period 32.4 +/- 1 microseconds at h = 3.1 mm (Falcon et
+    al. 1998, as reported in Brogliato 2010)."""
+    outcome = lawbench.solve("compliant", "bead_column", {"path": True}, n=10)
+    assert wall_force_period(outcome) == pytest.approx(32.4e-6, rel=0.15)

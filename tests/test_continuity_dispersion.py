@@ -111,3 +111,14 @@ def test_dispersion_check_compares_with_the_compliant_model():
     assert sequential.passed is True
     assert moreau.passed is False
     assert "index" in moreau.detail
+
+
+@pytest.mark.parametrize(("width", "height"), [(0.5, 1.0), (1.0, 1.0), (1.0, 2**0.5), (2.0, 1.0)])
+def test_kinetic_angle_of_the_rocking_block(width, height):
+    """Brogliato 2010, the rocking block: constraints h1,2 = y - (l/2) cos(theta) -+ (L/2)
+    sin(theta), l the height and L the width, orthogonal in the kinetic metric iff l = sqrt(2) L.
+    With I = m (l^2 + L^2) / 12 their angle is cos(theta_12) = (l^2 - 2 L^2) / (l^2 + 4 L^2).
+    """
+    problem = lawbench.CASES.get("rocking_block").build(width=width, height=height, mu=0.0)
+    cosine = (height**2 - 2 * width**2) / (height**2 + 4 * width**2)
+    assert kinetic_angles(problem)[0, 1] == pytest.approx(np.degrees(np.arccos(cosine)), abs=1e-9)

@@ -1,0 +1,47 @@
+"""Shared figure helpers: figures without pyplot, one colour and marker per law, log floors."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+
+from lawbench.law import LAWS
+
+# Exact zeros (an exact law against itself, no steps) are drawn at this floor on log axes.
+FLOOR = 1e-17
+MARKERS = "osD^v<>phP*X"
+
+
+def figure(rows: int, cols: int, width: float = 4.2, height: float = 3.2) -> tuple[Figure, Any]:
+    """A new figure with a ``rows`` x ``cols`` grid of axes (always a 2-D array)."""
+    fig = Figure(figsize=(cols * width, rows * height), layout="tight")
+    return fig, fig.subplots(rows, cols, squeeze=False)
+
+
+def law_style(name: str) -> dict[str, Any]:
+    """Colour and marker of a law, the same in every figure of a report."""
+    try:
+        names = LAWS.names()
+    except Exception:  # a registry that fails to load still gives each law a style
+        names = []
+    index = names.index(name) if name in names else len(names)
+    return {
+        "color": colormaps["tab10"](index % 10),
+        "marker": MARKERS[index % len(MARKERS)],
+        "label": name,
+    }
+
+
+def floored(values: Any) -> np.ndarray:
+    """``values`` as floats with zeros and tinier values raised to `FLOOR` (NaN kept)."""
+    array = np.asarray(values, dtype=float)
+    return np.where(np.isnan(array), np.nan, np.maximum(np.abs(array), FLOOR))
+
+
+def empty(axes: Any, text: str) -> None:
+    """Mark an axes that has nothing to show, with the reason."""
+    axes.text(0.5, 0.5, text, ha="center", va="center", wrap=True, transform=axes.transAxes)
+    axes.set_axis_off()
