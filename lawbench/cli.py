@@ -252,7 +252,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.set_defaults(mode="quick")
     report.set_defaults(run=_report)
     table = commands.add_parser("table", help="tabulate a study of several laws (CSV)")
-    table.add_argument("name", help="rocking_block or sphere_wall")
+    table.add_argument("name", help="rocking_block, sphere_wall or dispersion")
     table.add_argument("--out", metavar="FILE", help="write the table as CSV to FILE")
     table.set_defaults(run=_table)
     run = commands.add_parser("run", help="run a grid of laws x cases x parameters")

@@ -15,6 +15,9 @@ message. A law's failure on one row never stops the table.
   case's other defaults): the post-impact slip of the contact point along the pre-impact slip
   direction ``s`` (negative: reversed), the spin about ``n x s`` (positive: rolling along ``s``;
   rolling without slip is ``radius spin = vt``), and the impulse ratio ``-Pt.s / Pn``.
+- ``dispersion``: the share of the post-impact kinetic energy carried by each of three equal
+  balls struck by the first, and the dispersion index, for every law, as the stiffness ratio of
+  the two contacts goes from 1e-3 to 1e3 (rigid laws do not read it: their rows repeat).
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ ASPECT_RATIOS = np.logspace(-1.0, 1.0, 9)
 ROCKING_FRICTIONS = (0.0, 1.0)
 INCIDENCES = np.linspace(5.0, 85.0, 9)
 SPHERE_LAWS = ("brach", "whittaker", "darboux_keller")
+DISPERSION_RATIOS = np.logspace(-3.0, 3.0, 7)
 
 # A row of a study: its label columns and the case parameters it sets.
 Row = tuple[dict[str, Any], dict[str, Any]]
@@ -167,9 +171,44 @@ def sphere_wall_table() -> Table:
     return Table("sphere_wall", title, pd.DataFrame(records, columns=columns), notes)
 
 
+def dispersion_table() -> Table:
+    """Energy shares per ball on three equal balls struck by the first, as stiffness varies."""
+    from lawbench.checks.dispersion import dispersion_index
+    from lawbench.mechanics import energy_shares
+
+    rows = [
+        ({"stiffness_ratio": float(ratio)}, {"stiffness_ratio": float(ratio)})
+        for ratio in DISPERSION_RATIOS
+    ]
+
+    def measure(trial: Trial) -> dict[str, float]:
+        shares = energy_shares(trial.problem, trial.outcome.v_plus)
+        return {
+            **{f"share_{b}".replace(" ", "_"): s for b, s in shares.items()},
+            "dispersion_index": dispersion_index(shares),
+        }
+
+    records, notes = _study("three_ball_chain", LAWS.names(), rows, measure)
+    columns = [
+        "law",
+        "stiffness_ratio",
+        "share_ball_1",
+        "share_ball_2",
+        "share_ball_3",
+        "dispersion_index",
+    ]
+    title = (
+        "three equal balls, velocities (1, 0, 0), e = 1, Hertz contacts: share of the "
+        "post-impact kinetic energy per ball and the dispersion index (0: all in one ball) as "
+        "the stiffness of contact 1 over contact 0 goes from 1e-3 to 1e3"
+    )
+    return Table("dispersion", title, pd.DataFrame(records, columns=columns), notes)
+
+
 TABLES: dict[str, Callable[[], Table]] = {
     "rocking_block": rocking_block_table,
     "sphere_wall": sphere_wall_table,
+    "dispersion": dispersion_table,
 }
 
 

@@ -28,7 +28,7 @@ def dispersion_index(shares: dict[str, float]) -> float:
     values = np.array([s for s in shares.values() if s > 0])
     if len(shares) < 2 or values.size == 0:
         return 0.0
-    return float(-(values * np.log(values)).sum() / math.log(len(shares)))
+    return max(0.0, float(-(values * np.log(values)).sum() / math.log(len(shares))))
 
 
 @check("dispersion", several_solves=True)
