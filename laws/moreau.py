@@ -52,8 +52,9 @@ otherwise. With friction, the second-order cone QP in the impulses
   convex problem, until ``s`` changes by less than ``tol`` times the largest ``|q|``. Its
   optimality conditions are then De Saxce's. The iteration need not converge: the law may
   have several solutions or none when normal and tangential directions are strongly coupled,
-  and even where it has one the iterates can cycle (seen on a random planar problem with two
-  contacts). More than ``max_fixed_point`` steps raise `SolverFailure` with the count.
+  and even where it has one the plain iterates can cycle between two values; past 20 steps the
+  update is averaged (``s <- (s + mu |ut+|) / 2``), which breaks such cycles. More than
+  ``max_fixed_point`` steps raise `SolverFailure` with the count.
 - ``relaxed`` ("SOCP relaxed (clarabel)"): one convex problem with ``s = 0``, Anitescu's
   relaxation. Its conditions are ``un+_j + e_j r_j >= mu_j |ut+_j|`` instead of ``>= 0``: a
   slipping contact leaves with the extra normal rate ``mu_j |ut+_j|`` (it may separate where
@@ -197,6 +198,9 @@ class Moreau(Law):
         return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
 
 
+UNDAMPED = 20
+
+
 def _resolve_friction(
     problem: ImpactProblem, restitution: np.ndarray, options: dict[str, Any]
 ) -> Outcome:
@@ -215,10 +219,13 @@ def _resolve_friction(
         P, polished = result.P, result.polished
         if not exact:
             break
-        slip = np.linalg.norm(cones.split(G @ P + q, m, d)[1], axis=1)
-        change, s = np.abs(mu * slip - s).max(), mu * slip
+        target = mu * np.linalg.norm(cones.split(G @ P + q, m, d)[1], axis=1)
+        change = np.abs(target - s).max()
         if change <= tol * np.abs(q).max():
             break
+        # Plain substitution first; past UNDAMPED steps average, which breaks the two-cycles
+        # the plain iteration can fall into.
+        s = s + (1.0 if steps < UNDAMPED else 0.5) * (target - s)
         if steps >= options["max_fixed_point"]:
             raise SolverFailure(
                 f"moreau: the Coulomb fixed point did not converge in {steps} steps "
