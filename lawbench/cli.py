@@ -201,10 +201,10 @@ def _regress(args: argparse.Namespace) -> None:
     if args.update:
         print(f"baselines rewritten; {len(drift)} quantities changed")
         if len(drift):
-            print(drift.to_string(index=False))
+            print(drift.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
         return
     if len(drift):
-        print(drift.to_string(index=False))
+        print(drift.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
         raise Drift(f"regress: {len(drift)} quantities drifted past their tolerance")
     print("regress: every law holds its baseline")
 
