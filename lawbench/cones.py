@@ -30,6 +30,7 @@ import numpy as np
 import scipy.sparse
 
 from lawbench.errors import SolverFailure
+from lawbench.solvers import clarabel_settings
 
 NEWTON_STEPS = 30
 EPS = np.finfo(float).eps
@@ -94,18 +95,13 @@ def solve_cone_qp(
         else:
             cones += [clarabel.NonnegativeConeT(1), clarabel.ZeroConeT(d)]
     A = scipy.sparse.csc_matrix((values, (range(size), cols)), shape=(size, size))
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.max_iter = max_iter
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
-    settings.tol_ktratio = max(tol, 1e-12)
     solver = clarabel.DefaultSolver(
         scipy.sparse.csc_matrix(np.triu(G)),
         np.asarray(q, dtype=float),
         A,
         np.zeros(size),
         cones,
-        settings,
+        clarabel_settings(tol, max_iter),
     )
     solution = solver.solve()
     P, status = np.array(solution.x), str(solution.status)

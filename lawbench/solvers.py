@@ -36,6 +36,16 @@ class QPResult:
     iterations: int
 
 
+def clarabel_settings(tol: float, max_iter: int) -> clarabel.DefaultSettings:
+    """Settings of clarabel: quiet, with gap and feasibility tolerances ``tol``."""
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.max_iter = max_iter
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
+    settings.tol_ktratio = max(tol, 1e-12)
+    return settings
+
+
 def clarabel_qp(
     P: np.ndarray, c: np.ndarray, A: np.ndarray, tol: float, max_iter: int = 200
 ) -> QPResult:
@@ -43,18 +53,13 @@ def clarabel_qp(
 
     Returns whatever clarabel ended with; the caller decides whether its status will do.
     """
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.max_iter = max_iter
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
-    settings.tol_ktratio = max(tol, 1e-12)
     solver = clarabel.DefaultSolver(
         scipy.sparse.csc_matrix(np.triu(P)),
         np.asarray(c, dtype=float),
         scipy.sparse.csc_matrix(-A),
         np.zeros(A.shape[0]),
         [clarabel.NonnegativeConeT(A.shape[0])],
-        settings,
+        clarabel_settings(tol, max_iter),
     )
     solution = solver.solve()
     return QPResult(
