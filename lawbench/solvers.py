@@ -12,6 +12,7 @@ method (Lawson and Hanson) is finite and exact.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import clarabel
@@ -99,9 +100,12 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
     exact = np.zeros_like(q)
     if active.any():
         try:
-            exact[active] = scipy.linalg.solve(
-                G[np.ix_(active, active)], -q[active], assume_a="pos"
-            )
+            # An ill-conditioned block (redundant contacts) is fine: the answer is checked below.
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
+                exact[active] = scipy.linalg.solve(
+                    G[np.ix_(active, active)], -q[active], assume_a="pos"
+                )
         except (np.linalg.LinAlgError, ValueError):
             return None
     slack = G @ exact + q
