@@ -41,6 +41,9 @@ def test_an_interrupted_run_resumes_to_the_same_table(tmp_path, stop):
     assert whole.returncode == 0, whole.stderr
     process = subprocess.Popen(
         [sys.executable, "-m", "lawbench", *args, "--executor", "serial", "--out", "cut.parquet"],
+        # A shell without job control starts background jobs with SIGINT ignored, and Python
+        # then keeps ignoring it: give the run the default, as in a terminal.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
         cwd=tmp_path,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
