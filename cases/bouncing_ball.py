@@ -108,6 +108,17 @@ def frictionless(params: Params) -> str | None:
     return None if params["mu"] == 0 else "needs mu = 0"
 
 
+def frictionless_reference(case: type[Case]) -> Reference:
+    """The frictionless bounce of a body on the table, as the reference of ``case``."""
+    return Reference(
+        "frictionless bounce",
+        "un+ = -e un- at one frictionless contact (energetic = kinematic coefficient)",
+        "jia",
+        lambda p: frictionless_bounce(case().build(**p), p["e"]),
+        condition=frictionless,
+    )
+
+
 def vector_spec(name: str, default: list[float], doc: str, unit: str) -> Spec:
     """A three-component parameter."""
     return Spec(name, default, doc, unit, "floats")
@@ -143,15 +154,7 @@ class BouncingBall(Case):
         *contact_specs(0.5, 0.4, MINDLIN_RATIO),
     )
     requires = Requirements(friction=True, spatial=True)
-    references = (
-        Reference(
-            "frictionless bounce",
-            "un+ = -e un- at one frictionless contact (energetic = kinematic coefficient)",
-            "jia",
-            lambda p: frictionless_bounce(BouncingBall().build(**p), p["e"]),
-            condition=frictionless,
-        ),
-    )
+    references = ()  # set after the class: the reference builds the scene itself
     examples = {
         "default": {},
         "talk's spin sense": {"angular_velocity": [0.0, -2.0, 0.0]},
@@ -185,4 +188,5 @@ class BouncingBall(Case):
         return contact_point_momentum(np.array([0.0, 0.0, -params["radius"]]))
 
 
+BouncingBall.references = (frictionless_reference(BouncingBall),)
 CASES.register(BouncingBall())
