@@ -413,3 +413,17 @@ def test_report_writes_its_three_files(tmp_path):
     assert {row["law"] for row in rows} == set(lawbench.LAWS.names())
     assert {row["case"] for row in rows} <= set(lawbench.CASES.names())
     assert "<table" in (out / "index.html").read_text()
+
+
+@pytest.mark.parametrize(
+    ("args", "code", "pattern"),
+    [
+        (["solve", "whittaker", "falling_rod", "--set", "mu=-1"], 2, r"mu = -1"),
+        (["solve", "brach", "sphere_wall", "--set", "e_t=1.5"], 2, r"e_t = 1\.5"),
+        (["solve", "lzb", "sphere_wall"], 3, r"lzb: the problem is spatial"),
+    ],
+    ids=["negative-mu", "tangential-restitution-above-one", "planar-law-on-a-spatial-scene"],
+)
+def test_frictional_bad_input_has_the_right_exit_code(args, code, pattern):
+    line = assert_one_line_error(run_lawbench(*args), code)
+    assert re.search(pattern, line), line
