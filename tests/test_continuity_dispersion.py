@@ -57,7 +57,7 @@ def test_compliant_contacts_are_continuous_in_the_gaps():
     assert lawbench.CHECKS["continuity"](trial).passed is True
 
 
-@pytest.mark.parametrize("law", ["moreau", "compliant"])
+@pytest.mark.parametrize("law", ["moreau", "lzb", "compliant"])
 def test_velocity_perturbations_at_zero_gaps_are_continuous(law):
     trial = lawbench.evaluate(law, "three_ball_chain", **HEAD_ON)
     found = jumps(trial, (1e-2, 1e-4, 1e-6))
