@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Requirements, per_item
+from lawbench.case import CASES, Case, GroundTruth, Params, per_item
 from lawbench.chains import (
     NEWTONS_CRADLE,
     PLASTIC_CHAIN,
@@ -31,6 +31,7 @@ from lawbench.chains import (
 from lawbench.errors import InvalidProblem
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 
 class BallChain(Case):
@@ -56,7 +57,14 @@ class BallChain(Case):
         exponent_spec("floats"),
         gaps_spec(1),
     )
-    requires = Requirements(several_contacts=True)
+    requires = Tags(several_contacts=True)
+    ground_truth = GroundTruth(
+        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
+        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
+        "limits of the three-ball chain)",
+        law="compliant",
+        options={"rtol": 1e-10},
+    )
     references = (PLASTIC_CHAIN, NEWTONS_CRADLE)
 
     examples = {

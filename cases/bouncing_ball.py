@@ -33,10 +33,11 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, Requirements, exactly
+from lawbench.case import CASES, Case, Params, Reference, exactly
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import spatial_column
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 COORDINATES = ["vx [m/s]", "vy [m/s]", "vz [m/s]", "wx [rad/s]", "wy [rad/s]", "wz [rad/s]"]
 MINDLIN_RATIO = (2 - 0.3) / (2 * (1 - 0.3))
@@ -153,7 +154,7 @@ class BouncingBall(Case):
         Spec("mass", 1.0, "mass of the ball", "kg", "float", 0.0, low_open=True),
         *contact_specs(0.5, 0.4, MINDLIN_RATIO),
     )
-    requires = Requirements(friction=True, spatial=True)
+    requires = Tags(friction=True, spatial=True)
     references = ()  # set after the class: the reference builds the scene itself
     examples = {
         "default": {},

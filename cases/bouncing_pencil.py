@@ -41,9 +41,10 @@ from lawbench.cases.bouncing_ball import (
     vector_spec,
 )
 
-from lawbench.case import CASES, Case, Params, Requirements, exactly
+from lawbench.case import CASES, Case, Params, exactly
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 SPEED = 5.0
 DESCENT = math.pi / 6
@@ -117,7 +118,7 @@ class BouncingPencil(Case):
         ),
         *contact_specs(0.5, 0.8, 1.2),
     )
-    requires = Requirements(friction=True, spatial=True)
+    requires = Tags(friction=True, spatial=True)
     references = ()  # set after the class: the reference builds the scene itself
     examples = {
         "default": {},

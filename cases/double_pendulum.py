@@ -33,10 +33,11 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Requirements, exactly
+from lawbench.case import CASES, Case, Params, exactly
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
 
@@ -97,7 +98,7 @@ class DoublePendulum(Case):
         Spec("e", 0.9, "Newton's restitution coefficient", "", "float", 0.0, 1.0),
         Spec("mu", 0.5, "Coulomb friction coefficient", "", "float", 0.0),
     )
-    requires = Requirements(friction=True)
+    requires = Tags(friction=True)
     examples = {
         "default": {},
         "plastic": {"e": 0.0},

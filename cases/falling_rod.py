@@ -46,10 +46,11 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, Requirements, exactly
+from lawbench.case import CASES, Case, Params, Reference, exactly
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
 
@@ -174,7 +175,7 @@ class FallingRod(Case):
         Spec("e", 0.5, "Newton's restitution coefficient", "", "float", 0.0, 1.0),
         Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
     )
-    requires = Requirements(friction=True)
+    requires = Tags(friction=True)
     references = (
         *(
             Reference(

@@ -29,9 +29,10 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, Requirements
+from lawbench.case import CASES, Case, Params, Reference
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 _SOURCE = "Lubarda 2010 as given by Brogliato 2010, lamina on an anvil, eqs. (12)-(14)"
 
@@ -111,7 +112,7 @@ class Lamina(Case):
         ),
         Spec("mu", 0.5, "Coulomb friction coefficient", "", low=0.0),
     )
-    requires = Requirements(friction=True)
+    requires = Tags(friction=True)
     references = (
         _termination("newton", lambda r: 1.0, "-e omega-"),
         _termination("poisson", lambda r: r, "-e r omega-"),

@@ -45,10 +45,11 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, Requirements
+from lawbench.case import CASES, Case, Params, Reference
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
 
@@ -133,7 +134,7 @@ class RockingBlock(Case):
         Spec("e", 0.0, "Newton's restitution coefficient of both corners", "", "float", 0.0, 1.0),
         Spec("mu", 0.5, "Coulomb friction coefficient of both corners", "", "float", 0.0),
     )
-    requires = Requirements(friction=True, several_contacts=True)
+    requires = Tags(friction=True, several_contacts=True)
     # Both laws hold the landing corner with Newton's normal rule and Coulomb's friction on the
     # post-impact slip; without friction whittaker is moreau's unilateral law.
     references = tuple(

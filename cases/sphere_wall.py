@@ -30,10 +30,11 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, Requirements, exactly
+from lawbench.case import CASES, Case, Params, Reference, exactly
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import spatial_column
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 NORMAL = np.array([0.0, 1.0, 0.0])
 TANGENTS = (np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]))
@@ -103,7 +104,7 @@ class SphereWall(Case):
         ),
         Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
     )
-    requires = Requirements(friction=True, spatial=True)
+    requires = Tags(friction=True, spatial=True)
     references = (
         Reference(
             "eq. (11)",

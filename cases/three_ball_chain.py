@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, Requirements, exactly, per_item
+from lawbench.case import CASES, Case, GroundTruth, Params, Reference, exactly, per_item
 from lawbench.chains import (
     NEWTONS_CRADLE,
     PLASTIC_CHAIN,
@@ -27,6 +27,7 @@ from lawbench.chains import (
     velocities_spec,
 )
 from lawbench.problem import ImpactProblem
+from lawbench.tags import Tags
 
 
 def _equation_29(p: Params) -> np.ndarray:
@@ -75,7 +76,14 @@ class ThreeBallChain(Case):
         exponent_spec(),
         gaps_spec(2),
     )
-    requires = Requirements(several_contacts=True)
+    requires = Tags(several_contacts=True)
+    ground_truth = GroundTruth(
+        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
+        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
+        "limits of the three-ball chain)",
+        law="compliant",
+        options={"rtol": 1e-10},
+    )
     references = (
         Reference(
             "eq. (29)",

@@ -1,17 +1,26 @@
 """lawbench: compare the classical impact laws of rigid-body mechanics on shared scenes.
 
 The entry point is `solve` (or `evaluate`, which also keeps the problem and parameters for the
-checks). Laws and cases are in the registries `LAWS` and `CASES`.
+checks): a law on a registered scene or on an `ImpactProblem` of your own. Laws and cases are
+in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`.
 """
 
 from lawbench.api import evaluate, solve
-from lawbench.case import CASES, Case, Reference, Requirements
+from lawbench.case import CASES, Case, GroundTruth, Reference
 from lawbench.checks import CHECKS, CheckResult, Trial, run_checks
-from lawbench.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.errors import (
+    BudgetExceeded,
+    InvalidProblem,
+    LawbenchError,
+    NotApplicable,
+    SolverFailure,
+)
+from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
+from lawbench.verdicts import Claim, Region, Verdict
 
 __version__ = "0.1.0"
 
@@ -19,10 +28,12 @@ __all__ = [
     "CASES",
     "CHECKS",
     "LAWS",
-    "Capabilities",
+    "BudgetExceeded",
     "Case",
     "CheckResult",
+    "Claim",
     "Contact",
+    "GroundTruth",
     "ImpactProblem",
     "InvalidProblem",
     "Law",
@@ -30,10 +41,12 @@ __all__ = [
     "NotApplicable",
     "Outcome",
     "Reference",
-    "Requirements",
+    "Region",
     "SolverFailure",
     "Spec",
+    "Tags",
     "Trial",
+    "Verdict",
     "evaluate",
     "run_checks",
     "solve",

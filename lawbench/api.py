@@ -1,4 +1,4 @@
-"""The public entry points: solve a law on a case, or evaluate it with every check."""
+"""The public entry points: solve a law on a scene or a problem, or evaluate it for the checks."""
 
 from __future__ import annotations
 
@@ -7,25 +7,30 @@ from typing import Any
 
 from lawbench.case import CASES, Case
 from lawbench.checks import Trial
+from lawbench.errors import InvalidProblem
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
+from lawbench.problem import ImpactProblem
 
 
 def solve(
-    law: str | Law, case: str | Case, options: Mapping[str, Any] | None = None, **params: Any
+    law: str | Law,
+    case: str | Case | ImpactProblem,
+    options: Mapping[str, Any] | None = None,
+    **params: Any,
 ) -> Outcome:
-    """Solve the impact of ``case`` with ``law``.
+    """Solve the impact of a scene, or of a problem given as it is, with ``law``.
 
     Parameters
     ----------
     law : str or Law
         A registered law name (``lawbench list``) or a law object.
-    case : str or Case
-        A registered case name or a case object.
+    case : str, Case or ImpactProblem
+        A registered scene name, a scene object, or an impact problem of your own.
     options : mapping, optional
         The law's options (ordering, variant, tolerance).
     **params
-        The case's parameters; the others take their defaults.
+        The scene's parameters; the others take their defaults. None for a problem.
 
     Returns
     -------
@@ -34,7 +39,8 @@ def solve(
     Raises
     ------
     InvalidProblem
-        Unknown law, case, parameter or option, or a bad value.
+        Unknown law, case, parameter or option, a bad value, or parameters given with a
+        problem.
     NotApplicable
         The law cannot treat the case.
     SolverFailure
@@ -50,11 +56,36 @@ def solve(
 
 
 def evaluate(
-    law: str | Law, case: str | Case, options: Mapping[str, Any] | None = None, **params: Any
+    law: str | Law,
+    case: str | Case | ImpactProblem,
+    options: Mapping[str, Any] | None = None,
+    **params: Any,
 ) -> Trial:
-    """Like `solve`, but return the whole `Trial` (complete parameters, problem, outcome)."""
-    law, case = LAWS.get(law), CASES.get(case)
-    full = case.parameters(**params)
-    problem = case.build(**full)
+    """Like `solve`, but return the whole `Trial` (complete parameters, problem, outcome).
+
+    The trial is what `run_checks` reads.
+
+    Examples
+    --------
+    >>> import numpy as np, lawbench
+    >>> problem = lawbench.ImpactProblem.from_arrays(
+    ...     M=np.eye(2), Wn=[[-1.0], [1.0]], v=[1.0, 0.0], e=1.0
+    ... )
+    >>> trial = lawbench.evaluate("poisson", problem)
+    >>> trial.outcome.v_plus.tolist(), str(lawbench.run_checks(trial)["energy_gain"].verdict)
+    ([0.0, 1.0], 'holds')
+    """
+    law = LAWS.get(law)
+    if isinstance(case, ImpactProblem):
+        if params:
+            raise InvalidProblem(
+                f"scene parameters {sorted(params)} given with a problem: a problem is solved "
+                "as it is"
+            )
+        scene, full, problem = None, {}, case
+    else:
+        scene = CASES.get(case)
+        full = scene.parameters(**params)
+        problem = scene.build(**full)
     outcome = law.resolve(problem, **dict(options or {}))
-    return Trial(law, case, full, outcome.diagnostics["options"], problem, outcome)
+    return Trial(law, scene, full, outcome.diagnostics["options"], problem, outcome)

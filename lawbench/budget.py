@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 
-from lawbench.errors import SolverFailure
+from lawbench.errors import BudgetExceeded
 from lawbench.spec import Spec
 
 OPTION = Spec(
@@ -22,6 +22,9 @@ class Deadline:
     def check(self) -> None:
         """Raise if the budget is spent."""
         if time.monotonic() > self.end:
-            raise SolverFailure(
-                f"{self.law}: time budget ran out ({self.seconds:g} s, max_seconds)"
+            raise BudgetExceeded(
+                f"{self.law}: time budget ran out ({self.seconds:g} s, max_seconds)",
+                "max_seconds",
+                self.seconds,
+                self.seconds,
             )

@@ -15,30 +15,12 @@ from typing import Any, ClassVar
 import numpy as np
 
 from lawbench.errors import InvalidProblem
-from lawbench.law import Capabilities
 from lawbench.problem import ImpactProblem
 from lawbench.registry import Registry
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 Params = Mapping[str, Any]
-
-
-@dataclass(frozen=True)
-class Requirements:
-    """What a scene needs of a law (friction, several contacts, spatial, stiffness)."""
-
-    friction: bool = False
-    several_contacts: bool = False
-    spatial: bool = False
-    stiffness: bool = False
-
-    def met_by(self, capabilities: Capabilities) -> bool:
-        """Whether a law with ``capabilities`` can treat the scene."""
-        return (
-            (capabilities.friction or not self.friction)
-            and (capabilities.several_contacts or not self.several_contacts)
-            and (capabilities.spatial or not self.spatial)
-        )
 
 
 def _always(params: Params) -> str | None:
@@ -84,13 +66,46 @@ class Reference:
         return self.condition(params)
 
 
+@dataclass(frozen=True)
+class GroundTruth:
+    """What a scene's outcomes are measured against: a closed form or a converged model.
+
+    Attributes
+    ----------
+    why : str
+        Why this is the truth of the scene (which physics it resolves that the others do not).
+    reference : str or None
+        The name of one of the case's `Reference` closed forms, when the truth is exact.
+    law : str or None
+        Otherwise the law whose converged solution is the truth (a stated model).
+    options : mapping
+        That law's options for the converged solution (its tightest accuracy knob).
+    """
+
+    why: str
+    reference: str | None = None
+    law: str | None = None
+    options: Mapping[str, Any] = field(default_factory=dict)
+
+    def describe(self) -> str:
+        """A short label for table headers."""
+        if self.reference is not None:
+            return f"closed form ({self.reference})"
+        settings = ", ".join(
+            f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.options.items()
+        )
+        return f"{self.law} ({settings})" if settings else str(self.law)
+
+
 class Case(ABC):
     """Base class of the scenes."""
 
     name: ClassVar[str]
     summary: ClassVar[str]
     params: ClassVar[tuple[Spec, ...]]
-    requires: ClassVar[Requirements] = Requirements()
+    requires: ClassVar[Tags] = Tags()
+    # What the scene's outcomes are measured against (model error), and why.
+    ground_truth: ClassVar[GroundTruth | None] = None
     references: ClassVar[tuple[Reference, ...]] = ()
     # Named parameter sets that exercise the scene; every law and check runs on each.
     examples: ClassVar[Mapping[str, Params]] = {"default": {}}

@@ -58,13 +58,13 @@ def _list(args: argparse.Namespace) -> None:
 
 
 def _describe_law(law: Law) -> None:
-    caps = law.capabilities
+    tags = law.tags
     print(f"law {law.name}: {law.summary}")
     print(f"source: {law.source}")
     print(
-        f"capabilities: friction={caps.friction} several_contacts={caps.several_contacts} "
-        f"spatial={caps.spatial} needs_stiffness={caps.needs_stiffness} "
-        f"accuracy_knob={caps.accuracy_knob}"
+        f"tags: friction={tags.friction} several_contacts={tags.several_contacts} "
+        f"spatial={tags.spatial} stiffness={tags.stiffness} "
+        f"accuracy_knob={tags.accuracy_knob}"
     )
     print("options:" if law.options else "options: none")
     for spec in law.options:
@@ -115,8 +115,9 @@ def _solve(args: argparse.Namespace) -> None:
     print(f"T_minus = {record['T_minus']:.6g} J, T_plus = {record['T_plus']:.6g} J")
     print(f"formulation: {record['diagnostics'].get('formulation')}")
     for name, result in record["checks"].items():
-        verdict = {True: "pass", False: "FAIL", None: "skip"}[result["passed"]]
-        print(f"  {name:<14}{verdict:<6}{result['detail']}")
+        print(f"  {name:<14}{result['verdict']:<19}{result['detail']}")
+        if result["claim"]:
+            print(f"  {'':<14}{'':<19}{result['claim']}")
 
 
 def _report(args: argparse.Namespace) -> None:

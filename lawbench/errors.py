@@ -23,3 +23,28 @@ class NotApplicable(LawbenchError):
 
 class SolverFailure(LawbenchError):
     """A numerical method failed; the message gives the solver's status or the count reached."""
+
+
+class BudgetExceeded(SolverFailure):
+    """A numerical method ran out of a named budget before it finished.
+
+    Parameters
+    ----------
+    message : str
+        What ran out, in words.
+    budget : str
+        The option that sets the budget (``max_steps``, ``max_seconds``, ...).
+    amount : float
+        The budget's value.
+    spent_s : float or None
+        Wall time spent when the budget ran out, when known.
+    """
+
+    def __init__(
+        self, message: str, budget: str, amount: float, spent_s: float | None = None
+    ) -> None:
+        super().__init__(message)
+        self.budget, self.amount, self.spent_s = budget, amount, spent_s
+
+    def __reduce__(self) -> tuple:
+        return (type(self), (str(self), self.budget, self.amount, self.spent_s))

@@ -136,7 +136,7 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[tuple]:
         case = CASES.get(case_name)
         for law_name in laws:
             law = LAWS.get(law_name)
-            if every_law and not case.requires.met_by(law.capabilities):
+            if every_law and not law.tags.covers(case.requires):
                 continue
             option_values = {
                 name: values(spec, seed, (number, "option", law_name, name))

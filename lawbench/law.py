@@ -1,8 +1,8 @@
 """The law protocol: what every impact law declares and how it is called.
 
-A law subclasses `Law`, declares its name, summary, source, capabilities and options, and
-implements `Law._resolve`. `Law.resolve` does what is common to all of them: it checks the
-options and the problem against the capabilities, restricts the problem to its closed contacts
+A law subclasses `Law`, declares its name, summary, source, tags, options, findings and
+guarantees, and implements `Law._resolve`. `Law.resolve` does what is common to all of them: it
+checks the options and the problem against the tags, restricts the problem to its closed contacts
 (a contact with a positive gap is not part of this impact), times the solve, and refuses to
 return a non-finite answer.
 """
@@ -12,7 +12,6 @@ from __future__ import annotations
 import dataclasses
 import time
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
@@ -22,61 +21,31 @@ from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.registry import Registry
 from lawbench.spec import Spec
-
-
-@dataclass(frozen=True)
-class Capabilities:
-    """What a law can treat.
-
-    Attributes
-    ----------
-    friction : bool
-        Coulomb friction (problems with a tangential Jacobian and mu > 0).
-    several_contacts : bool
-        More than one contact at once.
-    spatial : bool
-        Spatial contacts (two tangential directions).
-    needs_stiffness : bool
-        The law reads contact stiffness and exponent.
-    accuracy_knob : str or None
-        Name of the option that trades accuracy for cost; None for exact laws.
-    """
-
-    friction: bool = False
-    several_contacts: bool = True
-    spatial: bool = False
-    needs_stiffness: bool = False
-    accuracy_knob: str | None = None
-
-    def refusal(self, problem: ImpactProblem) -> str | None:
-        """Why a law with these capabilities cannot treat ``problem``, or None."""
-        if problem.frictional and not self.friction:
-            return "the problem has friction (mu > 0) and this law is frictionless"
-        if problem.d == 2 and problem.frictional and not self.spatial:
-            return "the problem is spatial (two tangential directions) and this law is planar"
-        closed = int(problem.closed.sum())
-        if closed > 1 and not self.several_contacts:
-            return f"the problem has {closed} closed contacts and this law treats one"
-        return None
+from lawbench.tags import Tags
+from lawbench.verdicts import Claim
 
 
 class Law(ABC):
     """Base class of the impact laws.
 
     Subclasses set the class attributes and implement `_resolve`, which receives a problem
-    whose contacts are all closed and the complete, checked options.
+    whose contacts are all closed and the complete, checked options. ``tags`` say what the law
+    treats (`lawbench.tags.Tags`); ``findings`` and ``guarantees`` are `Claim` objects that
+    decide the verdict of a failed check (`lawbench.verdicts`).
     """
 
     name: ClassVar[str]
     summary: ClassVar[str]
     source: ClassVar[str]
-    capabilities: ClassVar[Capabilities]
+    tags: ClassVar[Tags]
     options: ClassVar[tuple[Spec, ...]] = ()
     # Whether the law follows contacts through their gaps (resolves time): then it receives the
     # whole problem; otherwise only the closed contacts, an open one being no part of the impact.
     follows_gaps: ClassVar[bool] = False
-    # Known defects of the law: (case, example, check) -> why the check fails there.
-    findings: ClassVar[dict[tuple[str, str, str], str]] = {}
+    # What the law's theory says of the checks: where one fails as the theory predicts
+    # (findings), and where one must hold, so that a failure there is numerical (guarantees).
+    findings: ClassVar[tuple[Claim, ...]] = ()
+    guarantees: ClassVar[tuple[Claim, ...]] = ()
 
     def option_values(self, given: dict[str, Any] | None = None) -> dict[str, Any]:
         """Return every option of this law, defaults filled in, checked and converted.
@@ -121,7 +90,7 @@ class Law(ABC):
             When the numerical method fails or would return a non-finite number.
         """
         values = self.option_values(options)
-        reason = self.capabilities.refusal(problem)
+        reason = self.tags.refusal(problem)
         if reason:
             raise NotApplicable(f"{self.name}: {reason}")
         closed = problem.closed

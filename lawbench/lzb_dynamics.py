@@ -34,7 +34,7 @@ import scipy.integrate
 import scipy.optimize
 
 from lawbench import budget
-from lawbench.errors import SolverFailure
+from lawbench.errors import BudgetExceeded, SolverFailure
 from lawbench.problem import ImpactProblem
 
 IDLE, COMPRESSION, EXPANSION = 0, 1, 2
@@ -422,8 +422,10 @@ class EnergeticImpact:
         while True:
             self.deadline.check()
             if sum(self.steps.values()) >= self.max_steps:
-                raise SolverFailure(
-                    f"lzb: integrator step budget ran out ({self.max_steps} steps, max_steps)"
+                raise BudgetExceeded(
+                    f"lzb: integrator step budget ran out ({self.max_steps} steps, max_steps)",
+                    "max_steps",
+                    self.max_steps,
                 )
             message = solver.step()
             self.steps[kind] += 1
@@ -443,8 +445,10 @@ class EnergeticImpact:
                     )
                     self.events += 1
                     if self.events > self.max_events:
-                        raise SolverFailure(
-                            f"lzb: event budget ran out ({self.max_events} events, max_events)"
+                        raise BudgetExceeded(
+                            f"lzb: event budget ran out ({self.max_events} events, max_events)",
+                            "max_events",
+                            self.max_events,
                         )
                     y_hit = dense(x_hit)
                     self.keep(y_hit, seg)

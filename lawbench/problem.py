@@ -191,6 +191,58 @@ class ImpactProblem:
         if not math.isfinite(energy):
             raise InvalidProblem(f"v and M give a kinetic energy that overflows ({energy})")
 
+    @classmethod
+    def from_arrays(
+        cls,
+        M: object,
+        Wn: object,
+        v: object,
+        Wt: object | None = None,
+        *,
+        gaps: object | None = None,
+        bodies: Mapping[str, Sequence[int]] | None = None,
+        **coefficients: object,
+    ) -> ImpactProblem:
+        """Build a problem from arrays and per-contact coefficients.
+
+        Parameters
+        ----------
+        M, Wn, v, Wt, gaps, bodies
+            As in the class.
+        **coefficients
+            Fields of `Contact` (``e``, ``mu``, ``stiffness``, ...): one value for every
+            contact, or a sequence with one value per column of ``Wn``.
+
+        Raises
+        ------
+        InvalidProblem
+            For an unknown coefficient, a sequence of the wrong length, or any bad field.
+        """
+        m = np.shape(Wn)[1] if np.ndim(Wn) == 2 else 0
+        known = {f.name for f in dataclasses.fields(Contact)}
+        per_contact: dict[str, list[object]] = {}
+        for name, value in coefficients.items():
+            if name not in known:
+                raise InvalidProblem(
+                    f"unknown contact coefficient {name!r}; known: {', '.join(sorted(known))}"
+                )
+            if isinstance(value, str) or not isinstance(value, Sequence | np.ndarray):
+                per_contact[name] = [value] * m
+            elif len(value) != m:
+                raise InvalidProblem(
+                    f"{name} has {len(value)} values, expected 1 or {m} (one per contact)"
+                )
+            else:
+                per_contact[name] = list(value)
+        for name, values in per_contact.items():
+            for j, value in enumerate(values):
+                if value is not None and not isinstance(value, int | float | np.number):
+                    raise InvalidProblem(f"contacts[{j}].{name} = {value!r}: not a number")
+        contacts = [
+            Contact(**{name: values[j] for name, values in per_contact.items()}) for j in range(m)
+        ]
+        return cls(M, Wn, v, contacts, Wt, dict(bodies or {}), gaps)
+
     def _check_normals(self) -> None:
         """Refuse a contact that no motion can push along its normal (a singular configuration).
 

@@ -27,6 +27,7 @@ from lawbench.api import evaluate
 from lawbench.checks import run_checks
 from lawbench.errors import InvalidProblem
 from lawbench.grid import Row, RunSpec
+from lawbench.verdicts import Verdict, of_error
 
 EXECUTORS = ("serial", "processes", "dask")
 STEP_KEYS = ("steps", "impacts", "iterations")
@@ -42,6 +43,7 @@ def compute(row: Row, checks: Sequence[str], settings: dict[str, Any]) -> dict[s
         "params": json.dumps(row.params, sort_keys=True),
         "options": json.dumps(row.options, sort_keys=True),
         "status": "error",
+        "verdict": str(Verdict.HOLDS),
         "error_class": "",
         "error_message": "",
     }
@@ -50,7 +52,9 @@ def compute(row: Row, checks: Sequence[str], settings: dict[str, Any]) -> dict[s
         trial.settings.update(settings)
         results = run_checks(trial, list(checks))
     except Exception as exc:  # a row records its failure and the run goes on
-        record.update(error_class=type(exc).__name__, error_message=str(exc))
+        record.update(
+            verdict=str(of_error(exc)), error_class=type(exc).__name__, error_message=str(exc)
+        )
         return record
     outcome = trial.outcome
     diagnostics = outcome.diagnostics
@@ -68,7 +72,9 @@ def compute(row: Row, checks: Sequence[str], settings: dict[str, Any]) -> dict[s
     )
     for name, result in results.items():
         record[f"{name}_value"] = np.nan if result.value is None else float(result.value)
-        record[f"{name}_verdict"] = {True: "pass", False: "fail", None: "skip"}[result.passed]
+        record[f"{name}_verdict"] = str(result.verdict)
+        claims = trial.law.findings if result.verdict == Verdict.LAW_PROPERTY else ()
+        record[f"{name}_finding"] = claims.index(result.claim) if result.claim in claims else -1
     return record
 
 

@@ -27,9 +27,13 @@ def trial_record(trial: Trial, checks: dict[str, CheckResult]) -> dict[str, Any]
     outcome = trial.outcome
     record = {
         "law": trial.law.name,
-        "case": trial.case.name,
+        "case": trial.scene,
         "params": trial.params,
-        "coordinates": trial.case.coordinates(trial.params),
+        "coordinates": (
+            trial.case.coordinates(trial.params)
+            if trial.case is not None
+            else [f"v[{i}]" for i in range(trial.problem.n)]
+        ),
         "v_minus": trial.problem.v,
         "v_plus": outcome.v_plus,
         "Pn": outcome.Pn,

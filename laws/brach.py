@@ -48,9 +48,12 @@ from typing import Any
 import numpy as np
 
 from lawbench.errors import NotApplicable
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.regions import coupled_friction
+from lawbench.tags import Tags
+from lawbench.verdicts import Claim
 
 # Below this fraction of |un-| a slip velocity counts as zero.
 NO_SLIP = 1e-12
@@ -69,11 +72,17 @@ class Brach(Law):
     name = "brach"
     summary = "Brach's bilinear law (e, e_t, mu) at one contact, with effective masses"
     source = "Brach 1989, 1991; Brogliato 2010, eq. (11)"
-    capabilities = Capabilities(friction=True, several_contacts=False, spatial=True)
+    tags = Tags(friction=True, several_contacts=False, spatial=True)
 
-    findings = {
-        ("falling_rod", "energy gain", "energy_gain"): _REVERSAL_GAIN,
-    }
+    findings = (
+        Claim(
+            "energy_gain",
+            coupled_friction,
+            "Kane and Levinson 1985; Brogliato 2010, after eq. (9) and eq. (11)",
+            _REVERSAL_GAIN,
+            (("falling_rod", "energy gain"),),
+        ),
+    )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         un = float(problem.un[0])

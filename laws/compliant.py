@@ -50,11 +50,12 @@ import scipy.integrate
 import scipy.optimize
 
 from lawbench import budget
-from lawbench.errors import NotApplicable, SolverFailure
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.errors import BudgetExceeded, NotApplicable, SolverFailure
+from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 MODELS = ("kelvin_voigt", "hertz", "hunt_crossley")
 DAMPING_RULES = {
@@ -106,7 +107,7 @@ class Compliant(Law):
         "time integration of unilateral compliant contacts (Kelvin-Voigt, Hertz, Hunt-Crossley)"
     )
     source = "Brogliato 2010, compliant contacts; Hunt and Crossley 1975; Flores et al. 2011"
-    capabilities = Capabilities(several_contacts=True, needs_stiffness=True, accuracy_knob="rtol")
+    tags = Tags(several_contacts=True, stiffness=True, accuracy_knob="rtol")
     follows_gaps = True
     options = (
         Spec("model", "hunt_crossley", "force law of every contact", kind="str", choices=MODELS),
@@ -246,8 +247,10 @@ class _Integration:
         while not self.ended(y):
             deadline.check()
             if steps == options["max_steps"]:
-                raise SolverFailure(
-                    f"compliant: integrator step budget ran out ({steps} steps, max_steps)"
+                raise BudgetExceeded(
+                    f"compliant: integrator step budget ran out ({steps} steps, max_steps)",
+                    "max_steps",
+                    steps,
                 )
             before = self.switches(*self.physical(y)[::2])
             message = solver.step()
@@ -263,8 +266,10 @@ class _Integration:
                 y_new = dense(t_new)
                 restarts += 1
                 if restarts > options["max_events"]:
-                    raise SolverFailure(
-                        f"compliant: event budget ran out ({restarts - 1} restarts)"
+                    raise BudgetExceeded(
+                        f"compliant: event budget ran out ({restarts - 1} restarts, max_events)",
+                        "max_events",
+                        options["max_events"],
                     )
             for s in np.linspace(t, t_new, 5)[1:]:
                 peak = np.maximum(peak, self.forces(*self.physical(dense(s))[::2]))

@@ -61,10 +61,11 @@ from typing import Any
 import numpy as np
 
 from lawbench.impulse_dynamics import ImpactRecord, SingleContactImpact, State, path_arrays
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 # Each termination reads the contact's coefficient of its own kind.
 COEFFICIENT = {"newton": "newton", "poisson": "poisson", "energetic": "energy"}
@@ -79,9 +80,7 @@ class DarbouxKeller(Law):
         "Newton, Poisson or Stronge termination"
     )
     source = "Darboux 1880, Keller 1986, Stronge 1990; Brogliato 2010, eqs. (2)-(4), (12)-(15)"
-    capabilities = Capabilities(
-        friction=True, several_contacts=False, spatial=True, accuracy_knob="rtol"
-    )
+    tags = Tags(friction=True, several_contacts=False, spatial=True, accuracy_knob="rtol")
     options = (
         Spec(
             "termination",

@@ -60,11 +60,12 @@ import numpy as np
 
 from lawbench.errors import NotApplicable
 from lawbench.jia_dynamics import SpringImpact, Springs
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 POISSON_RATIO = 0.3
 DEFAULT_TANGENTIAL_STIFFNESS_RATIO = (2 - POISSON_RATIO) / (2 * (1 - POISSON_RATIO))
@@ -83,11 +84,11 @@ class Jia(Law):
         "Jia, IJRR 32(1) 2013 (tangential compliance); Jia, Mason and Erdmann, IJRR 32(1) 2013 "
         "(multiple impacts)"
     )
-    capabilities = Capabilities(
+    tags = Tags(
         friction=True,
         several_contacts=True,
         spatial=True,
-        needs_stiffness=True,
+        stiffness=True,
         accuracy_knob="tolerance",
     )
     options = (

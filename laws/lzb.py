@@ -115,12 +115,13 @@ import numpy as np
 import scipy.special
 
 from lawbench import budget
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.law import LAWS, Law
 from lawbench.lzb_dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 
 class LiuZhaoBrogliato(Law):
@@ -132,9 +133,7 @@ class LiuZhaoBrogliato(Law):
         "ratios and stored energies, Stronge's coefficient per contact"
     )
     source = "Brogliato 2010, eqs. (32)-(48); Liu, Zhao, Brogliato 2008, 2009; Zhang et al. 2013"
-    capabilities = Capabilities(
-        friction=True, several_contacts=True, needs_stiffness=True, accuracy_knob="rtol"
-    )
+    tags = Tags(friction=True, several_contacts=True, stiffness=True, accuracy_knob="rtol")
     options = (
         Spec(
             "variant",

@@ -79,13 +79,16 @@ from typing import Any
 import numpy as np
 
 from lawbench import cones
-from lawbench.errors import SolverFailure
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.errors import BudgetExceeded
+from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.regions import coupled_friction, option, separating_contact
 from lawbench.solvers import project_on_cone, solve_lcp
 from lawbench.spec import Spec
+from lawbench.tags import Tags
+from lawbench.verdicts import Claim
 
 _SLIP_REVERSAL = (
     "kinematic restitution with Coulomb friction on the post-impact slip (at one contact "
@@ -107,9 +110,7 @@ class Moreau(Law):
         "Moreau 1988; Brogliato 2010, eqs. (16)-(17); De Saxce and Feng 1991; Acary et al. "
         "2011; Anitescu 2006"
     )
-    capabilities = Capabilities(
-        friction=True, several_contacts=True, spatial=True, accuracy_knob="tol"
-    )
+    tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="tol")
     options = (
         Spec(
             "tol",
@@ -153,16 +154,32 @@ class Moreau(Law):
         ),
     )
 
-    findings = {
-        ("three_ball_chain", "separating contact", "energy_gain"): (
-            "contact 1 separates before the impact (un- = 0.75 m/s); dragged into the impact "
-            "by ball 2 it is held at un+ = 0 without restitution, and its impulse adds "
-            "Pn un- / 2 > 0 to the energy change: kinematic restitution per contact is not "
-            "dissipative once a separating contact takes part"
+    findings = (
+        Claim(
+            "energy_gain",
+            separating_contact & option("separating", "unilateral"),
+            "Brogliato 2010, Moreau's law; dT = sum Pn_j (un-_j + un+_j) / 2",
+            "a contact that separates before the impact, dragged into it by its neighbours, is "
+            "held at un+ = 0 without restitution, and its impulse adds Pn un- / 2 > 0 to the "
+            "energy change: kinematic restitution per contact is not dissipative once a "
+            "separating contact takes part",
+            (("three_ball_chain", "separating contact"),),
         ),
-        ("falling_rod", "energy gain", "energy_gain"): _SLIP_REVERSAL,
-        ("double_pendulum", "default", "energy_gain"): _SLIP_REVERSAL,
-    }
+        Claim(
+            "admissible",
+            separating_contact & option("separating", "restitution"),
+            "Brogliato 2010, Moreau's law (premise v- in -T(q))",
+            "the cone projection restitutes the separating contact's rate too, and can leave it "
+            "approaching after the impact",
+        ),
+        Claim(
+            "energy_gain",
+            coupled_friction,
+            "Kane and Levinson 1985; Brogliato 2010, eq. (8)",
+            _SLIP_REVERSAL,
+            (("falling_rod", "energy gain"), ("double_pendulum", "default")),
+        ),
+    )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         e, un = problem.restitution("newton"), problem.un
@@ -227,9 +244,11 @@ def _resolve_friction(
         # the plain iteration can fall into.
         s = s + (1.0 if steps < UNDAMPED else 0.5) * (target - s)
         if steps >= options["max_fixed_point"]:
-            raise SolverFailure(
+            raise BudgetExceeded(
                 f"moreau: the Coulomb fixed point did not converge in {steps} steps "
-                f"(last change of mu |ut+| {change:.3g}, tolerance {tol:g})"
+                f"(last change of mu |ut+| {change:.3g}, tolerance {tol:g}, max_fixed_point)",
+                "max_fixed_point",
+                steps,
             )
     if exact and options["polish"]:
         # The last cone QP had the previous s; solve Coulomb's law itself on its states.

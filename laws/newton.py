@@ -20,11 +20,15 @@ from typing import Any
 import numpy as np
 
 from lawbench.errors import NotApplicable
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.regions import separating_contact
+from lawbench.tags import Tags
+from lawbench.verdicts import Claim
 
+_SOURCE = "Brogliato 2010, eq. (29) and the discussion of separating contacts after it"
 _ASKS_APPROACH = (
     "every closed contact is active: the wall or ball contact that separates before the "
     "impact is asked to approach at -e un- after it"
@@ -37,15 +41,24 @@ class Newton(Law):
     name = "newton"
     summary = "Newton's kinematic restitution at every closed contact at once"
     source = "Newton's law; generalized Newton law, Brogliato 2010, eq. (29)"
-    capabilities = Capabilities(several_contacts=True)
+    tags = Tags(several_contacts=True)
 
-    findings = {
-        ("three_ball_chain", "separating contact", "admissible"): _ASKS_APPROACH,
-        ("three_ball_chain", "separating contact", "impulse_sign"): (
-            "holding contact 1 to un+ = -e un- needs a tensile impulse"
+    findings = (
+        Claim(
+            "admissible",
+            separating_contact,
+            _SOURCE,
+            _ASKS_APPROACH,
+            (("three_ball_chain", "separating contact"), ("two_balls_wall", "separating ball")),
         ),
-        ("two_balls_wall", "separating ball", "admissible"): _ASKS_APPROACH,
-    }
+        Claim(
+            "impulse_sign",
+            separating_contact,
+            _SOURCE,
+            "holding a separating contact to un+ = -e un- needs a tensile impulse",
+            (("three_ball_chain", "separating contact"),),
+        ),
+    )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         G = problem.delassus

@@ -22,10 +22,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.solvers import solve_lcp
+from lawbench.tags import Tags
 
 
 class Poisson(Law):
@@ -34,7 +35,7 @@ class Poisson(Law):
     name = "poisson"
     summary = "Poisson's kinetic restitution: compression then expansion complementarity problems"
     source = "Pfeiffer and Glocker 1996, ch. 7; Brogliato 2010, kinetic coefficient"
-    capabilities = Capabilities(several_contacts=True)
+    tags = Tags(several_contacts=True)
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         G, e = problem.delassus, problem.restitution("poisson")

@@ -26,11 +26,12 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.errors import SolverFailure
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.errors import BudgetExceeded
+from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.tags import Tags
 
 APPROACH_TOLERANCE = 1e-12
 RECORDED = 10_000
@@ -43,7 +44,7 @@ class Sequential(Law):
     name = "sequential"
     summary = "pairwise binary Newton impacts in a chosen order until no contact approaches"
     source = "Brogliato 2010, eqs. (27)-(28): sequences of binary impacts"
-    capabilities = Capabilities(several_contacts=True, accuracy_knob="order")
+    tags = Tags(several_contacts=True, accuracy_knob="order")
     options = (
         Spec(
             "order",
@@ -101,10 +102,12 @@ class _BinaryImpacts:
     def strike(self, j: int) -> None:
         """Newton's binary impact at contact j alone; raise past the bound on impacts."""
         if len(self.contacts) == self.max_impacts:
-            raise SolverFailure(
+            raise BudgetExceeded(
                 f"sequential: contacts still approach after {len(self.contacts)} binary impacts "
                 f"(max_impacts = {self.max_impacts}; a sequence that does not end, such as an "
-                "inelastic collapse)"
+                "inelastic collapse)",
+                "max_impacts",
+                self.max_impacts,
             )
         impulse = -(1.0 + self.e[j]) * self.un[j] / self.G[j, j]
         self.Pn[j] += impulse

@@ -78,11 +78,14 @@ import numpy as np
 import scipy.optimize
 
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
-from lawbench.law import LAWS, Capabilities, Law
+from lawbench.law import LAWS, Law
 from lawbench.lemke import RayTermination, lemke
 from lawbench.mechanics import is_diagonal, kinetic_energy
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.regions import coupled_friction, separating_contact
+from lawbench.tags import Tags
+from lawbench.verdicts import Claim
 
 # Largest number of planar contacts whose 4^m mode combinations are enumerated.
 MAX_ENUMERATED = 4
@@ -391,17 +394,26 @@ class Whittaker(Law):
         "Whittaker 1904; Brogliato 2010, friction at the impulse level, eqs. (6)-(8); "
         "Kane and Levinson 1985"
     )
-    capabilities = Capabilities(friction=True, several_contacts=True, spatial=True)
+    tags = Tags(friction=True, several_contacts=True, spatial=True)
 
-    findings = {
-        ("three_ball_chain", "separating contact", "energy_gain"): (
-            "without friction the law is moreau's unilateral LCP: contact 1 separates before "
-            "the impact, is held at un+ = 0 without restitution, and its impulse adds "
-            "Pn un- / 2 > 0 to the energy change"
+    findings = (
+        Claim(
+            "energy_gain",
+            separating_contact,
+            "Brogliato 2010, Moreau's law and separating contacts",
+            "without friction the law is moreau's unilateral LCP: a contact that separates "
+            "before the impact is held at un+ = 0 without restitution, and its impulse adds "
+            "Pn un- / 2 > 0 to the energy change",
+            (("three_ball_chain", "separating contact"),),
         ),
-        ("falling_rod", "energy gain", "energy_gain"): _SLIP_REVERSAL,
-        ("double_pendulum", "default", "energy_gain"): _SLIP_REVERSAL,
-    }
+        Claim(
+            "energy_gain",
+            coupled_friction,
+            "Kane and Levinson 1985; Brogliato 2010, eqs. (6)-(9)",
+            _SLIP_REVERSAL,
+            (("falling_rod", "energy gain"), ("double_pendulum", "default")),
+        ),
+    )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         if not problem.frictional:

@@ -155,7 +155,7 @@ def test_solve_json_record_has_the_documented_shape():
     assert isinstance(record["status"], str)
     assert set(record["checks"]) == set(SINGLE_SOLVE)
     for name, result in record["checks"].items():
-        assert set(result) == {"value", "passed", "detail"}, name
+        assert set(result) == {"value", "passed", "verdict", "detail", "claim"}, name
         assert result["passed"] in (True, False, None), name
         assert isinstance(result["detail"], str), name
 

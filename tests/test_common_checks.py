@@ -2,10 +2,12 @@
 
 (``continuity`` and ``dispersion`` solve the case again; their own tests cover them.)
 
-The pattern of scikit-learn's common estimator checks: the case's requirements and the law's
-capabilities decide what runs; a check that does not apply is skipped with its reason; a known
-defect of a law is listed in the law's ``findings`` with the reason and runs as a strict
-expected failure, so a finding that stops holding is noticed.
+The pattern of scikit-learn's common estimator checks: the scene's tags and the law's decide
+what runs; a check that does not apply is skipped with its reason. Every cell must end in a
+verdict a table may ship: *holds*, *refused*, or *law property* (a failure the law's findings
+predict, run as an expected failure with the finding's reason). A *numerical failure* or an
+*unexplained* verdict fails the test. Each finding is also held to its witnesses, so a finding
+that stops holding is noticed.
 """
 
 from functools import cache
@@ -14,6 +16,7 @@ import pytest
 
 import lawbench
 from lawbench.checks import SINGLE_SOLVE
+from lawbench.verdicts import Verdict
 
 
 @cache
@@ -29,21 +32,16 @@ def trial(law_name, case_name, example):
 def combinations():
     for law in lawbench.LAWS:
         for case in lawbench.CASES:
-            if not case.requires.met_by(law.capabilities):
+            if not law.tags.covers(case.requires):
                 continue
             for example in case.examples:
                 for check in SINGLE_SOLVE:
-                    key = (case.name, example, check)
-                    marks = []
-                    if key in law.findings:
-                        marks = [pytest.mark.xfail(reason=law.findings[key], strict=True)]
                     yield pytest.param(
                         law.name,
                         case.name,
                         example,
                         check,
                         id=f"{law.name}-{case.name}-{example}-{check}".replace(" ", "_"),
-                        marks=marks,
                     )
 
 
@@ -53,16 +51,34 @@ def test_common_check(law, case, example, check):
     if isinstance(solved, str):
         pytest.skip(f"the law does not apply: {solved}")
     result = lawbench.CHECKS[check](solved)
-    if result.passed is None:
+    if result.verdict == Verdict.REFUSED:
         pytest.skip(result.detail)
-    assert result.passed, result.detail
+    if result.verdict == Verdict.LAW_PROPERTY:
+        pytest.xfail(result.claim.describe())
+    assert result.verdict == Verdict.HOLDS, f"{result.verdict}: {result.detail}"
 
 
-def test_every_finding_names_a_real_case_example_and_check():
+def witnesses():
     for law in lawbench.LAWS:
-        for case, example, check in law.findings:
-            assert example in lawbench.CASES.get(case).examples, (law.name, case, example)
-            assert check in lawbench.CHECKS, (law.name, check)
+        for claim in law.findings:
+            for case, example in claim.witnesses:
+                yield pytest.param(
+                    law.name,
+                    claim,
+                    case,
+                    example,
+                    id=f"{law.name}-{claim.check}-{case}-{example}".replace(" ", "_"),
+                )
+
+
+@pytest.mark.parametrize(("law", "claim", "case", "example"), list(witnesses()))
+def test_every_finding_is_met_at_its_witnesses(law, claim, case, example):
+    """A finding's witness fails the check, and the verdict names that finding."""
+    assert claim.check in lawbench.CHECKS
+    assert example in lawbench.CASES.get(case).examples
+    result = lawbench.CHECKS[claim.check](trial(law, case, example))
+    assert result.verdict == Verdict.LAW_PROPERTY, result.detail
+    assert result.claim == claim
 
 
 def first_scene(law_name):
@@ -96,6 +112,8 @@ def test_every_law_states_its_source_and_conventions(law):
     doc = __import__(module_doc, fromlist=["_"]).__doc__
     assert entry.source and entry.summary
     assert "Source" in doc and "onvention" in doc, law
+    for claim in (*entry.findings, *entry.guarantees):
+        assert claim.source and claim.reason and claim.region.text, (law, claim.check)
 
 
 @pytest.mark.parametrize("case", lawbench.CASES.names())

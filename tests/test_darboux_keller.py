@@ -354,4 +354,4 @@ def test_refuses_several_contacts_and_bad_options():
         LAW.resolve(problem, termination="ivanov")
     with pytest.raises(lawbench.InvalidProblem, match="rtol"):
         LAW.resolve(problem, rtol=0.5)
-    assert LAW.capabilities.accuracy_knob == "rtol"
+    assert LAW.tags.accuracy_knob == "rtol"

@@ -371,11 +371,11 @@ def test_fixed_point_steps_are_bounded_and_reported():
         MOREAU.resolve(problem, max_fixed_point=steps - 1)
 
 
-def test_options_and_capabilities():
+def test_options_and_tags():
     """Friction, several contacts and spatial problems; friction mode checked on input."""
-    capabilities = MOREAU.capabilities
-    assert capabilities.friction and capabilities.several_contacts and capabilities.spatial
-    assert capabilities.accuracy_knob == "tol"
+    tags = MOREAU.tags
+    assert tags.friction and tags.several_contacts and tags.spatial
+    assert tags.accuracy_knob == "tol"
     with pytest.raises(lawbench.InvalidProblem, match="friction"):
         MOREAU.resolve(random_problem(0, 1), friction="exact")
 

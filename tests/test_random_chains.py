@@ -167,7 +167,7 @@ def test_random_chains_are_deterministic(seed):
     that the integrated laws stay within their budgets)."""
     _, problem = random_chain(seed, most=5)
     for law in lawbench.LAWS:
-        if problem.m > 1 and not law.capabilities.several_contacts:
+        if problem.m > 1 and not law.tags.several_contacts:
             continue
         if law.name == "lzb":
             continue  # dissipative chains cost it tens of seconds: see its own test below

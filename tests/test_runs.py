@@ -102,7 +102,8 @@ def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
     )
     table, computed = run(spec, tmp_path / "out.csv", file_format="csv")
     assert computed == 2
-    assert list(table["error_class"].fillna("")) == ["SolverFailure", ""]
+    assert list(table["error_class"].fillna("")) == ["BudgetExceeded", ""]
+    assert list(table["verdict"]) == ["budget", "holds"]
     assert "after 5 binary impacts" in table["error_message"][0]
 
 

@@ -15,7 +15,8 @@ from lawbench.cases.rocking_block import housner_ratio
 import lawbench
 from lawbench import tables
 from lawbench.errors import SolverFailure
-from lawbench.law import Capabilities, Law
+from lawbench.law import Law
+from lawbench.tags import Tags
 
 
 @pytest.fixture(scope="module")
@@ -113,7 +114,7 @@ class _Flaky(Law):
     name = "flaky"
     summary = "fails above 40 degrees"
     source = "none"
-    capabilities = Capabilities(friction=True, several_contacts=False, spatial=True)
+    tags = Tags(friction=True, spatial=True)
     findings: ClassVar[dict] = {}
 
     def _resolve(self, problem, options):

@@ -4,9 +4,9 @@ The shares of the post-impact kinetic energy carried by each body (``problem.bod
 dispersion index: the Shannon entropy of the shares over its largest value,
 ``D = -sum s_b ln s_b / ln(number of bodies)``, 0 when one body carries all the energy (the
 textbook, non-dispersive outcome of a chain) and 1 when every body carries the same. The
-reference is the high-fidelity compliant model (`compliant`, its default force law, tolerance
-1e-10) on the same case and parameters; the value is the largest difference of a share, and
-the outcome agrees with the reference when it is below 0.05.
+reference is the scene's ground truth when it is a converged model (``Case.ground_truth``: for
+the chains, compliant contacts at the scene's stiffnesses) on the same problem; the value is the
+largest difference of a share, and the outcome agrees with the reference when it is below 0.05.
 """
 
 from __future__ import annotations
@@ -33,19 +33,22 @@ def dispersion_index(shares: dict[str, float]) -> float:
 
 @check("dispersion", several_solves=True)
 def dispersion(trial: Trial) -> tuple:
-    """Largest share difference against the compliant model; agrees below 0.05."""
+    """Largest share difference against the scene's converged model; agrees below 0.05."""
     problem = trial.problem
     if len(problem.bodies) < 2:
         return None, None, "fewer than two bodies"
+    truth = trial.case.ground_truth if trial.case is not None else None
+    if truth is None or truth.law is None:
+        return None, None, "the scene declares no converged model as its ground truth"
     try:
-        reference = LAWS.get("compliant").resolve(problem, rtol=1e-10)
+        reference = LAWS.get(truth.law).resolve(problem, **truth.options)
     except LawbenchError as exc:
-        return None, None, f"no compliant reference: {type(exc).__name__}: {exc}"
+        return None, None, f"no reference ({truth.law}): {type(exc).__name__}: {exc}"
     shares = energy_shares(problem, trial.outcome.v_plus)
     expected = energy_shares(problem, reference.v_plus)
     value = max(abs(shares[b] - expected[b]) for b in shares)
     detail = (
-        f"index {dispersion_index(shares):.3f} (compliant {dispersion_index(expected):.3f}); "
+        f"index {dispersion_index(shares):.3f} ({truth.law} {dispersion_index(expected):.3f}); "
         "shares " + ", ".join(f"{b} {s:.3f}" for b, s in shares.items())
     )
     return value, value <= AGREEMENT, detail

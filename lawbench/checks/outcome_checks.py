@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg
 
 from lawbench.checks.base import TOLERANCE, Trial, check
 from lawbench.mechanics import gap_rates
@@ -22,7 +23,7 @@ def energy_gain(trial: Trial) -> tuple:
     return relative, passed, f"{verb} energy: dT = {outcome.dT:.6g} J, T- = {outcome.T_minus:.6g} J"
 
 
-@check("admissible")
+@check("admissible", promised=True)
 def admissible(trial: Trial) -> tuple:
     """Smallest post-impact gap rate of the closed contacts over the largest pre-impact one."""
     closed = trial.problem.closed
@@ -37,7 +38,7 @@ def admissible(trial: Trial) -> tuple:
     return value, False, f"contact {worst} approaches after the impact (un+ = {after.min():.6g})"
 
 
-@check("impulse_sign")
+@check("impulse_sign", promised=True)
 def impulse_sign(trial: Trial) -> tuple:
     """Smallest normal impulse over the largest one; a negative impulse is tensile."""
     Pn = trial.outcome.Pn
@@ -47,7 +48,7 @@ def impulse_sign(trial: Trial) -> tuple:
     return value, False, f"contact {int(np.argmin(Pn))} has a tensile impulse {Pn.min():.6g}"
 
 
-@check("friction_cone")
+@check("friction_cone", promised=True)
 def friction_cone(trial: Trial) -> tuple:
     """Largest excess ``|Pt_j| - mu_j Pn_j`` over the largest impulse; <= 0 inside the cones."""
     problem, outcome = trial.problem, trial.outcome
@@ -63,13 +64,21 @@ def friction_cone(trial: Trial) -> tuple:
     return value, False, f"contact {j}: |Pt| = {tangential[j]:.6g} exceeds mu Pn = {bound:.6g}"
 
 
-@check("momentum")
+@check("momentum", promised=True)
 def momentum(trial: Trial) -> tuple:
-    """Largest change of a conserved momentum over the largest momentum."""
-    axes = trial.case.momentum_axes(trial.params)
-    if axes is None:
-        return None, None, "the scene does not conserve momentum (a wall or a fixed point)"
+    """Largest change of a conserved momentum over the largest momentum.
+
+    The conserved momenta are the scene's (``Case.momentum_axes``), or for a problem given as it
+    is, every ``a @ M @ v`` with ``W.T @ a = 0``: the directions no contact impulse can push.
+    """
     M, v = trial.problem.M, trial.problem.v
+    if trial.case is not None:
+        axes = trial.case.momentum_axes(trial.params)
+    else:
+        free = scipy.linalg.null_space(trial.problem.W.T)
+        axes = free.T if free.size else None
+    if axes is None:
+        return None, None, "no momentum is conserved (a wall or a fixed point)"
     change = axes @ M @ (trial.outcome.v_plus - v)
     value = float(np.abs(change).max()) / _scale(M @ v)
     passed = value <= TOLERANCE

@@ -48,7 +48,7 @@ def _scenes(ctx: Context) -> tuple[list, list[str]]:
 def start(ctx: Context) -> Callable[[], Section]:
     """Start the section's runs; the returned function builds it."""
     scenes, notes = _scenes(ctx)
-    pairs = [(c, law) for c in scenes for law in ctx.laws if c.requires.met_by(law.capabilities)]
+    pairs = [(c, law) for c in scenes for law in ctx.laws if law.tags.covers(c.requires)]
     jobs = [
         Job(law.name, case.name, {"stiffness_ratio": ratio})
         for case, law in pairs

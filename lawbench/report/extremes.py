@@ -151,7 +151,7 @@ def plan(ctx: Context) -> tuple[list[Cell], list[str]]:
             cells += _job_cells(ctx, case, "stiffness ratio", "stiffness_ratio", ratios)
     three, chain = scene("three_ball_chain"), scene("ball_chain")
     for law in ctx.laws:
-        if law.capabilities.several_contacts and three:
+        if law.tags.several_contacts and three:
             cells += _mass_cells(law, three, config, lambda r: {"masses": [r, 1.0, 1.0]})
         elif chain:
             cells += _mass_cells(law, chain, config, lambda r: {"n": 2, "masses": [r, 1.0]})
@@ -179,7 +179,7 @@ def _job_cells(
 ) -> list[Cell]:
     cells = []
     for law in ctx.laws:
-        if not case.requires.met_by(law.capabilities):
+        if not law.tags.covers(case.requires):
             continue
         for value in values:
             form = param(case, name, value)
@@ -209,13 +209,13 @@ def _problem_cells(ctx: Context, case: Case, axis: str, values: tuple[float, ...
         for value in values:
             problem = grazing(base, value) if axis == "grazing speed" else duplicated(base)
             for law in ctx.laws:
-                if case.requires.met_by(law.capabilities):
+                if law.tags.covers(case.requires):
                     cells.append(Cell(law.name, axis, case.name, value, e, None, problem, extra))
     return cells
 
 
 def _tolerance(law: Law, options: dict[str, Any]) -> float:
-    knob = law.capabilities.accuracy_knob
+    knob = law.tags.accuracy_knob
     value = law.option_values(options).get(knob) if knob else None
     if isinstance(value, float):
         return max(TOLERANCE, 1e3 * value)

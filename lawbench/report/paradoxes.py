@@ -49,11 +49,7 @@ def _plan(ctx: Context) -> tuple[list[tuple], list[Job], list[str]]:
         if case is None:
             notes.append(f"scene `{name}` is not registered: its map is left out")
             continue
-        laws = [
-            law
-            for law in ctx.laws
-            if law.capabilities.friction and case.requires.met_by(law.capabilities)
-        ]
+        laws = [law for law in ctx.laws if law.tags.friction and law.tags.covers(case.requires)]
         if not laws:
             notes.append(f"no frictional law can treat `{name}`: its map is left out")
             continue

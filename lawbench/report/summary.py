@@ -18,14 +18,22 @@ from lawbench.checks import CHECKS, SINGLE_SOLVE
 from lawbench.law import Law
 from lawbench.report.page import Section, Table
 from lawbench.report.runs import Batch, Context, Job, error_text
+from lawbench.verdicts import Verdict
 
 ANCHOR, TITLE = "summary", "Summary matrix"
 
-SYMBOLS = {"pass": "✓", "skip": "·"}
+SYMBOLS = {
+    Verdict.HOLDS: "✓",
+    Verdict.LAW_PROPERTY: "✗",
+    Verdict.NUMERICAL_FAILURE: "✗!",
+    Verdict.REFUSED: "·",
+    Verdict.BUDGET: "⧗",
+    Verdict.UNEXPLAINED: "?!",
+}
 LEGEND = (
-    "✓ passes; ✗! fails, and no finding explains it; ✗ (#n) fails as expected, explained by "
-    "finding n; "
-    "· does not apply (the check gave its reason)"
+    "✓ holds; ✗ (#n) law property, predicted by the law's finding n; ✗! numerical failure (the "
+    "law's theory says it holds); · refused (the check does not apply, with its reason); "
+    "⧗ budget; ?! unexplained"
 )
 
 
@@ -36,18 +44,8 @@ def default_example(case: Case) -> tuple[str, dict[str, Any]]:
 
 
 def unmet(case: Case, law: Law) -> str:
-    """Why a scene is not for a law (its requirements against the law's capabilities)."""
-    needs, caps = case.requires, law.capabilities
-    missing = [
-        word
-        for word, needed, has in (
-            ("friction", needs.friction, caps.friction),
-            ("several contacts", needs.several_contacts, caps.several_contacts),
-            ("spatial contacts", needs.spatial, caps.spatial),
-        )
-        if needed and not has
-    ]
-    return "the scene needs " + " and ".join(missing)
+    """Why a scene is not for a law (its required tags against the law's)."""
+    return "the scene needs " + " and ".join(law.tags.missing(case.requires))
 
 
 def default_batch(ctx: Context) -> Batch:
@@ -56,7 +54,7 @@ def default_batch(ctx: Context) -> Batch:
         Job(law.name, case.name, default_example(case)[1])
         for case in ctx.cases
         for law in ctx.laws
-        if case.requires.met_by(law.capabilities)
+        if law.tags.covers(case.requires)
     ]
     settings = {"continuity_sizes": list(ctx.config.summary_continuity_sizes)}
     return ctx.batch("defaults", jobs, checks=ordered_checks(), settings=settings)
@@ -87,37 +85,35 @@ def findings(ctx: Context) -> list[dict[str, Any]]:
     """Every finding of the selected laws, numbered, with its anchor."""
     rows = []
     for law in ctx.laws:
-        for (case, example, check), reason in sorted(law.findings.items()):
+        for index, claim in enumerate(law.findings):
             number = len(rows) + 1
             rows.append(
                 {
                     "finding": number,
                     "anchor": f"finding-{number}",
                     "law": law.name,
-                    "case": case,
-                    "example": example,
-                    "check": check,
-                    "reason": reason,
+                    "index": index,
+                    "check": claim.check,
+                    "where": claim.region.text,
+                    "source": claim.source,
+                    "reason": claim.reason,
                 }
             )
     return rows
 
 
-def _verdict(record: dict[str, Any], check: str, finding: dict | None) -> str:
-    verdict = record.get(f"{check}_verdict", "skip")
-    if verdict == "fail":
-        return "finding" if finding else "fail"
-    return verdict if verdict in ("pass", "skip") else "skip"
+def _verdict(record: dict[str, Any], check: str) -> Verdict:
+    return Verdict(record.get(f"{check}_verdict", Verdict.REFUSED))
 
 
-def _cell(verdicts: dict[str, str], short: dict[str, str], numbers: dict[str, int]) -> str:
+def _cell(verdicts: dict[str, Verdict], short: dict[str, str], numbers: dict[str, int]) -> str:
     parts = []
     for check, verdict in verdicts.items():
-        if verdict == "finding":
+        if check in numbers:
             n = numbers[check]
             parts.append(f"{short[check]}✗ ([#{n}](#finding-{n}))")
         else:
-            parts.append(short[check] + SYMBOLS.get(verdict, "✗!"))
+            parts.append(short[check] + SYMBOLS[verdict])
     return " ".join(parts)
 
 
@@ -130,7 +126,7 @@ def start(ctx: Context) -> Callable[[], Section]:
 def _matrix(ctx: Context, listed: list[dict], checks: list[str]) -> tuple[dict, list, dict]:
     """Cell texts by law and case, the tidy rows, and the verdict met by each finding."""
     records = default_records(ctx)
-    by_key = {(f["law"], f["case"], f["example"], f["check"]): f for f in listed}
+    by_key = {(f["law"], f["index"]): f for f in listed}
     short = abbreviations(checks)
     matrix: dict[str, dict[str, str]] = {}
     tidy, observed = [], {}
@@ -151,11 +147,11 @@ def _matrix(ctx: Context, listed: list[dict], checks: list[str]) -> tuple[dict, 
                 continue
             verdicts, numbers = {}, {}
             for check in checks:
-                finding = by_key.get((law.name, case.name, example, check))
-                verdicts[check] = _verdict(record, check, finding)
-                if finding:
+                verdicts[check] = _verdict(record, check)
+                finding = by_key.get((law.name, record.get(f"{check}_finding", -1)))
+                if verdicts[check] == Verdict.LAW_PROPERTY and finding:
                     numbers[check] = finding["finding"]
-                    observed[finding["finding"]] = verdicts[check]
+                    observed.setdefault(finding["finding"], []).append(case.name)
             matrix[law.name][case.name] = _cell(verdicts, short, numbers)
             values = {f"{c}_value": record.get(f"{c}_value") for c in checks}
             tidy.append({**row, "status": "ran", **verdicts, **values, "error": ""})
@@ -170,44 +166,31 @@ def _build(ctx: Context) -> Section:
     frame = pd.DataFrame(matrix).T.rename_axis("law").reset_index()
     columns = ["law", "case", "example", "status", *checks, *(f"{c}_value" for c in checks)]
     data = pd.DataFrame(tidy).reindex(columns=[*columns, "error"])
-    unexpected = int((data[checks] == "fail").sum().sum())
-    expected = int((data[checks] == "finding").sum().sum())
-    errors = int((data["status"] == "error").sum())
+    counts = {v: int((data[checks] == v).sum().sum()) for v in Verdict}
     legend = ", ".join(f"{s} = {c}" for c, s in short.items())
     sizes = ", ".join(f"{s:g}" for s in ctx.config.summary_continuity_sizes)
     caption = (
         f"Every law on every scene it can treat, at the scene's default parameters (its first "
         f"example), with every check ({legend}); continuity perturbed at sizes {sizes}. "
-        f"{LEGEND}; — the scene's requirements exceed the law's capabilities; otherwise the "
+        f"{LEGEND}; — the scene's requirements exceed the law's tags; otherwise the "
         f"error the solve raised."
     )
+    columns = ["finding", "law", "check", "where", "in this run", "reason", "source"]
     list_rows = [
-        {
-            "finding": f["anchor"],
-            "law": f["law"],
-            "case": f["case"],
-            "example": f["example"],
-            "check": f["check"],
-            "in this run": _observed(f, observed),
-            "reason": f["reason"],
-        }
-        for f in listed
+        {**f, "finding": f["anchor"], "in this run": _observed(f, observed)} for f in listed
     ]
-    findings_frame = pd.DataFrame(
-        list_rows,
-        columns=["finding", "law", "case", "example", "check", "in this run", "reason"],
-    )
+    findings_frame = pd.DataFrame(list_rows, columns=columns)
     return Section(
         ANCHOR,
         TITLE,
         [
+            f"{counts[Verdict.UNEXPLAINED]} unexplained cells (?!). "
             f"{len(data) - int((data['status'] == 'not run').sum())} law-scene pairs ran: "
-            f"{unexpected} failures no finding explains (✗!), {expected} expected failures "
-            f"(findings), {errors} pairs raised an error.",
+            + ", ".join(f"{n} {v}" for v, n in counts.items())
+            + f"; {int((data['status'] == 'error').sum())} pairs raised an error.",
             Table("comparison", caption, frame, data),
-            "Findings: known defects of the laws (each a property of the law, run by the test "
-            "suite as an expected failure). Only the default example appears in the matrix; "
-            "the findings on other examples are listed too.",
+            "Findings: what each law's theory predicts to fail, with the region where it "
+            "applies and its source (the test suite holds every finding at its witnesses).",
             Table(
                 "findings",
                 "The findings of every law, with the reason; 'in this run' says what the "
@@ -219,8 +202,8 @@ def _build(ctx: Context) -> Section:
     )
 
 
-def _observed(finding: dict[str, Any], observed: dict[int, str]) -> str:
-    verdict = observed.get(finding["finding"])
-    if verdict is None:
-        return "not in the matrix (another example, or the scene did not run)"
-    return "fails as expected" if verdict == "finding" else f"does not fail ({verdict})"
+def _observed(finding: dict[str, Any], observed: dict[int, list[str]]) -> str:
+    scenes = observed.get(finding["finding"])
+    if not scenes:
+        return "not met in the matrix (its witnesses are other examples)"
+    return "met on " + ", ".join(scenes)

@@ -44,7 +44,7 @@ def _accepts(spec: Any, value: Any) -> bool:
 
 def knob_values(law: Law, values: tuple[float, ...]) -> tuple[str | None, list[Any]]:
     """The knob's name and the values swept (``[None]``: one point at the defaults)."""
-    knob = law.capabilities.accuracy_knob
+    knob = law.tags.accuracy_knob
     spec = next((s for s in law.options if s.name == knob), None)
     if spec is None:
         return None, [None]
@@ -86,11 +86,11 @@ def _plan(ctx: Context) -> tuple[list[Job], list[Job], list[dict[str, Any]]]:
     for case in _scenes(ctx)[0]:
         params = default_example(case)[1]
         tight = ctx.config.reference_knob
-        shared = compliant is not None and case.requires.met_by(compliant.capabilities)
+        shared = compliant is not None and compliant.tags.covers(case.requires)
         if shared:
             references.append(Job(REFERENCE_LAW, case.name, params, tightest(compliant, tight)))
         for law in ctx.laws:
-            if not case.requires.met_by(law.capabilities):
+            if not law.tags.covers(case.requires):
                 continue
             if not shared:
                 references.append(Job(law.name, case.name, params, tightest(law, tight)))
