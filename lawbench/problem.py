@@ -250,7 +250,15 @@ class ImpactProblem:
         straight down onto the floor), and every law's impulse would be meaningless.
         """
         W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
-        inverse_mass = np.linalg.eigvalsh(self.solve_mass(np.eye(self.n))).max()
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            inverse = self.solve_mass(np.eye(self.n))
+        if not np.isfinite(inverse).all():
+            diagonal = np.diag(self.M)
+            raise InvalidProblem(
+                f"M is too close to singular: its inverse overflows (smallest diagonal entry "
+                f"M[{int(np.argmin(diagonal))}, {int(np.argmin(diagonal))}] = {diagonal.min():.3g})"
+            )
+        inverse_mass = np.linalg.eigvalsh(inverse).max()
         scale = inverse_mass * float((W**2).sum(axis=0).max())
         normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
         for j in np.flatnonzero(normal <= 1e-12 * scale):
