@@ -5,6 +5,8 @@ checks): a law on a registered scene or on an `ImpactProblem` of your own. Laws 
 in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`.
 """
 
+import importlib.metadata
+
 from lawbench.api import evaluate, solve
 from lawbench.case import CASES, Case, GroundTruth, Reference
 from lawbench.checks import CHECKS, CheckResult, Trial, run_checks
@@ -22,7 +24,7 @@ from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim, Region, Verdict
 
-__version__ = "0.1.0"
+__version__ = importlib.metadata.version("lawbench")
 
 __all__ = [
     "CASES",

@@ -13,6 +13,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from lawbench import __version__
 from lawbench.api import evaluate
 from lawbench.case import CASES, Case
 from lawbench.checks import run_checks
@@ -213,6 +214,7 @@ def _regress(args: argparse.Namespace) -> None:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lawbench`` command."""
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
+    parser.add_argument("--version", action="version", version=f"lawbench {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     commands.add_parser("list", help="list the laws and cases").set_defaults(run=_list)
     describe = commands.add_parser("describe", help="describe a law or a case")

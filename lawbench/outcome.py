@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lawbench.mechanics import kinetic_energy, velocity_after
 from lawbench.problem import ImpactProblem
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,6 +44,29 @@ class Outcome:
     status: str = "ok"
     diagnostics: dict[str, Any] = field(default_factory=dict)
     path: dict[str, np.ndarray] | None = None
+
+    def to_frame(self) -> pd.DataFrame:
+        """The outcome as a tidy frame: one row per quantity and index (v_plus, Pn, Pt, energy).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``quantity``, ``index`` (coordinate or contact; -1 for a scalar), ``value``.
+        """
+        import pandas as pd
+
+        rows = [
+            (name, i, float(x))
+            for name in ("v_plus", "Pn", "Pt")
+            for i, x in enumerate(getattr(self, name))
+        ]
+        rows += [(name, -1, float(getattr(self, name))) for name in ("T_minus", "T_plus", "dT")]
+        return pd.DataFrame(rows, columns=["quantity", "index", "value"])
+
+    def _repr_html_(self) -> str:
+        formulation = self.diagnostics.get("formulation", "")
+        head = f"<p>Outcome ({self.status}; {formulation})</p>"
+        return head + self.to_frame().to_html(index=False)
 
     @property
     def dT(self) -> float:

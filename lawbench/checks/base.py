@@ -9,13 +9,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from lawbench.case import Case
 from lawbench.law import Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.verdicts import Claim, Verdict, judge
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 # Relative tolerance of the verdicts: a law that is exact must pass them to rounding.
 TOLERANCE = 1e-9
@@ -82,6 +85,26 @@ class CheckResult:
         }
 
 
+class CheckResults(dict[str, CheckResult]):
+    """Check name -> result, as `run_checks` returns them, with a tidy frame and HTML view."""
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per check: name, verdict, value, raw result, detail, deciding claim.
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
+        import pandas as pd
+
+        rows = [{"check": name, **result.as_dict()} for name, result in self.items()]
+        columns = ["check", "verdict", "value", "passed", "detail", "claim"]
+        return pd.DataFrame(rows, columns=columns)
+
+    def _repr_html_(self) -> str:
+        return self.to_frame().to_html(index=False)
+
+
 Check = Callable[[Trial], CheckResult]
 CHECKS: dict[str, Check] = {}
 # The checks that read the one outcome of a trial; the others solve the problem again.
@@ -114,6 +137,6 @@ def check(
     return register
 
 
-def run_checks(trial: Trial, names: list[str] | None = None) -> dict[str, CheckResult]:
+def run_checks(trial: Trial, names: list[str] | None = None) -> CheckResults:
     """Run the named checks on ``trial`` (by default every single-solve check), in order."""
-    return {name: CHECKS[name](trial) for name in names or SINGLE_SOLVE}
+    return CheckResults({name: CHECKS[name](trial) for name in names or SINGLE_SOLVE})
