@@ -8,10 +8,16 @@ polished (the active set clarabel finds is solved exactly and kept when it satis
 conditions to rounding, so the answer does not carry the interior-point tolerance); or as the
 non-negative least-squares problem ``min |R z + R^-T q|`` with ``G = R.T R``, whose active-set
 method (Lawson and Hanson) is finite and exact.
+
+A problem of a few contacts (at most `ENUMERATION_MAX`) is solved exactly by enumerating its
+active sets (`enumerate_lcp`): each set's equations are one small linear solve, and numpy does
+them for a whole batch of problems at once, which is what makes many small impacts cheap.
 """
 
 from __future__ import annotations
 
+import functools
+import itertools
 import warnings
 from dataclasses import dataclass
 
@@ -25,6 +31,10 @@ from lawbench.errors import SolverFailure
 from lawbench.mechanics import is_diagonal
 
 ROUNDING = 1e-12
+# Contacts up to which active-set enumeration (2**m sets) is the exact, cheap method.
+ENUMERATION_MAX = 6
+# Relative violation of z >= 0 and w >= 0 accepted as rounding.
+COMPLEMENTARITY = 1e-10
 
 
 @dataclass(frozen=True)
@@ -116,6 +126,73 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
     return np.maximum(exact, 0.0)
 
 
+@functools.cache
+def _active_sets(m: int) -> tuple[np.ndarray, ...]:
+    """Every subset of m contacts as index arrays, smallest first, then in lexicographic order."""
+    return tuple(
+        np.array(subset, dtype=int)
+        for size in range(m + 1)
+        for subset in itertools.combinations(range(m), size)
+    )
+
+
+def _solve_blocks(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Solve the stacked systems ``A[k] x[k] = b[k]``; a singular block gets its least norm."""
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore", RuntimeWarning)
+        try:
+            return np.linalg.solve(A, b[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            return (np.linalg.pinv(A) @ b[..., None])[..., 0]
+
+
+def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Solve ``0 <= G z + q _|_ z >= 0`` by enumerating active sets, for a batch of problems.
+
+    Parameters
+    ----------
+    G : array (..., m, m)
+        Symmetric positive (semi)definite matrices; one matrix serves every problem.
+    q : array (..., m)
+        Constant terms, one row per problem.
+
+    Returns
+    -------
+    z : array (..., m)
+        The solution on the first active set (smallest, then lexicographic) whose equations
+        give ``z >= 0`` and ``w >= 0`` to rounding; zeros where no set does.
+    found : array (...) of bool
+        Where a set was found. For a positive definite ``G`` the LCP has exactly one solution,
+        so a problem without one is numerically singular and the caller solves it otherwise.
+    """
+    q = np.asarray(q, dtype=float)
+    batch, m = q.shape[:-1], q.shape[-1]
+    qs = q.reshape(-1, m)
+    Gs = np.broadcast_to(np.asarray(G, dtype=float), (*batch, m, m)).reshape(-1, m, m)
+    z = np.zeros_like(qs)
+    found = np.zeros(len(qs), dtype=bool)
+    velocity_scale = np.maximum(np.abs(qs).max(axis=1, initial=0.0), ROUNDING)
+    for active in _active_sets(m):
+        todo = np.flatnonzero(~found)
+        if todo.size == 0:
+            break
+        candidate = np.zeros((todo.size, m))
+        if active.size:
+            block = Gs[todo][:, active[:, None], active]
+            candidate[:, active] = _solve_blocks(block, -qs[todo][:, active])
+        with np.errstate(all="ignore"):
+            slack = np.einsum("kij,kj->ki", Gs[todo], candidate) + qs[todo]
+            impulse_scale = np.maximum(np.abs(candidate).max(axis=1), ROUNDING)
+            good = (
+                np.isfinite(candidate).all(axis=1)
+                & (candidate.min(axis=1) >= -COMPLEMENTARITY * impulse_scale)
+                & (slack.min(axis=1) >= -COMPLEMENTARITY * velocity_scale[todo])
+            )
+        z[todo[good]] = np.maximum(candidate[good], 0.0)
+        found[todo[good]] = True
+    return z.reshape(*batch, m), found.reshape(batch)
+
+
 def solve_lcp(
     G: np.ndarray, q: np.ndarray, tol: float = 1e-10, refine: bool = True, method: str = "clarabel"
 ) -> LCPResult:
@@ -132,7 +209,8 @@ def solve_lcp(
     refine : bool
         Whether to polish clarabel's answer on its active set.
     method : {'clarabel', 'nnls'}
-        The solver of coupled problems.
+        The solver of coupled problems beyond `ENUMERATION_MAX` contacts (or where the
+        enumeration finds no set, a numerically singular problem).
     """
     if is_diagonal(G):
         diagonal = np.diag(G)
@@ -141,6 +219,10 @@ def solve_lcp(
         z = np.maximum(-q / diagonal, 0.0)
         method = "closed form" if len(q) == 1 else "decoupled (diagonal Delassus)"
         return LCPResult(z, G @ z + q, method)
+    if len(q) <= ENUMERATION_MAX:
+        z, found = enumerate_lcp(G, q)
+        if found:
+            return LCPResult(z, G @ z + q, "LCP (active-set enumeration)")
     if method == "nnls":
         return _nnls_lcp(G, q)
     result = clarabel_qp(G, q, np.eye(len(q)), tol)

@@ -39,12 +39,14 @@ energy. Neither choice is both admissible and dissipative on every scene; the ch
 ``admissible`` and ``energy_gain`` report which property fails.
 
 Formulations (``diagnostics['formulation']``). Without friction (no ``Wt``, or every
-``mu = 0``): closed form for one contact, decoupled for a diagonal Delassus matrix, the cone
-projection (a QP in the velocities, solved with clarabel) for one coefficient when no closed
-contact separates, and the LCP in the impulses (a QP in ``Pn >= 0``, solved with clarabel)
-otherwise. With friction, the second-order cone QP in the impulses
-``min P.G P / 2 + (q + s).P`` over the cones ``K_j`` (``G`` the contact Delassus matrix,
-``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clarabel
+``mu = 0``): closed form for one contact, decoupled for a diagonal Delassus matrix, the LCP in
+the impulses solved exactly by active-set enumeration up to ``ENUMERATION_MAX`` contacts
+(`lawbench.solvers.enumerate_lcp`; for one coefficient its solution is ``(1 + e)`` times the
+plastic projection's), and beyond that the cone projection (a QP in the velocities, solved with
+clarabel) for one coefficient when no closed contact separates, or the LCP in the impulses (a
+QP in ``Pn >= 0``, solved with clarabel) otherwise. With friction, the second-order cone QP in
+the impulses ``min P.G P / 2 + (q + s).P`` over the cones ``K_j`` (``G`` the contact Delassus
+matrix, ``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clarabel
 (`lawbench.cones`); option ``friction``:
 
 - ``coulomb`` (default, "SOCP fixed point (clarabel)"): the exact law. Starting from
@@ -79,13 +81,14 @@ from typing import Any
 import numpy as np
 
 from lawbench import cones
+from lawbench.batch import ProblemBatch
 from lawbench.errors import BudgetExceeded
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.regions import coupled_friction, option, separating_contact
-from lawbench.solvers import project_on_cone, solve_lcp
+from lawbench.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim
@@ -190,7 +193,8 @@ class Moreau(Law):
         if problem.frictional:
             return _resolve_friction(problem, e * restituted, options)
         single_e = len(set(e)) == 1 and np.array_equal(restituted, un)
-        if single_e and not is_diagonal(problem.delassus):
+        large = problem.m > ENUMERATION_MAX
+        if single_e and large and not is_diagonal(problem.delassus):
             plastic = project_on_cone(
                 problem.M,
                 problem.v,
@@ -213,6 +217,19 @@ class Moreau(Law):
             "polished": result.polished,
         }
         return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
+
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """The per-contact LCP by active-set enumeration, for every problem at once."""
+        if batch.m > ENUMERATION_MAX:
+            return None
+        un = batch.un
+        restituted = np.minimum(un, 0.0) if options["separating"] == "unilateral" else un
+        Pn, found = enumerate_lcp(batch.delassus, un + batch.restitution("newton") * restituted)
+        if not found.all():
+            return None
+        return Pn, "LCP (active-set enumeration, batch)"
 
 
 UNDAMPED = 20
