@@ -7,7 +7,8 @@ in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`.
 
 import importlib.metadata
 
-from lawbench.api import evaluate, solve
+from lawbench.api import evaluate, solve, solve_batch
+from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.case import CASES, Case, GroundTruth, Reference
 from lawbench.checks import CHECKS, CheckResult, Trial, run_checks
 from lawbench.errors import (
@@ -42,6 +43,8 @@ __all__ = [
     "LawbenchError",
     "NotApplicable",
     "Outcome",
+    "OutcomeBatch",
+    "ProblemBatch",
     "Reference",
     "Region",
     "SolverFailure",
@@ -52,4 +55,5 @@ __all__ = [
     "evaluate",
     "run_checks",
     "solve",
+    "solve_batch",
 ]

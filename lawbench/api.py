@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
+from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.case import CASES, Case
 from lawbench.checks import Trial
 from lawbench.errors import InvalidProblem
@@ -89,3 +90,38 @@ def evaluate(
         problem = scene.build(**full)
     outcome = law.resolve(problem, **dict(options or {}))
     return Trial(law, scene, full, outcome.diagnostics["options"], problem, outcome)
+
+
+def solve_batch(
+    law: str | Law,
+    batch: ProblemBatch | Sequence[ImpactProblem],
+    options: Mapping[str, Any] | None = None,
+) -> OutcomeBatch:
+    """Solve many impact problems of one shape with ``law``, vectorized where the law can.
+
+    Parameters
+    ----------
+    law : str or Law
+        A registered law name or a law object.
+    batch : ProblemBatch or sequence of ImpactProblem
+        Stacked arrays (`ProblemBatch`), or problems of one shape to stack.
+    options : mapping, optional
+        The law's options, checked once.
+
+    Returns
+    -------
+    OutcomeBatch
+        Stacked outcomes; equal to solving one by one, to rounding.
+
+    Examples
+    --------
+    >>> import numpy as np, lawbench
+    >>> v = np.array([[1.0, 0.0, 0.0], [2.0, 1.0, 0.0]])
+    >>> chain = [[-1.0, 0.0], [1.0, -1.0], [0.0, 1.0]]
+    >>> batch = lawbench.ProblemBatch(M=np.eye(3), Wn=chain, v=v, coefficients={"e": 1.0})
+    >>> lawbench.solve_batch("moreau", batch).v_plus.round(6).tolist()
+    [[-0.333333, 0.666667, 0.666667], [0.0, 1.0, 2.0]]
+    """
+    if not isinstance(batch, ProblemBatch):
+        batch = ProblemBatch.from_problems(list(batch))
+    return LAWS.get(law).resolve_batch(batch, **dict(options or {}))

@@ -16,6 +16,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
@@ -117,6 +118,55 @@ class Law(ABC):
     @abstractmethod
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         """Resolve a problem whose contacts are all closed."""
+
+    def resolve_batch(self, batch: ProblemBatch, **options: Any) -> OutcomeBatch:
+        """Resolve every problem of ``batch``: vectorized where the law can, else one by one.
+
+        Parameters
+        ----------
+        batch : ProblemBatch
+            Problems of one shape, validated once.
+        **options
+            The law's options, checked once for the whole batch.
+
+        Returns
+        -------
+        OutcomeBatch
+            Equal to resolving each problem with `resolve`, to rounding.
+
+        Raises
+        ------
+        InvalidProblem, NotApplicable, SolverFailure
+            As `resolve`; one by one, the first problem that raises stops the batch.
+        """
+        values = self.option_values(options)
+        start = time.perf_counter()
+        Pn = self._resolve_batch(batch, values)
+        if Pn is not None:
+            formulation = Pn[1]
+            result = OutcomeBatch.from_impulses(batch, Pn[0], formulation=formulation)
+        else:
+            outcomes = [self.resolve(batch.problem(k), **values) for k in range(len(batch))]
+            result = OutcomeBatch(
+                np.stack([o.v_plus for o in outcomes]),
+                np.stack([o.Pn for o in outcomes]),
+                np.array([o.T_minus for o in outcomes]),
+                np.array([o.T_plus for o in outcomes]),
+                {"formulation": "one by one"},
+            )
+        if not np.isfinite(result.v_plus).all():
+            raise SolverFailure(f"{self.name}: non-finite v_plus in a batch")
+        result.diagnostics.update(options=values, wall_time_s=time.perf_counter() - start)
+        return result
+
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """The impulses (B, m) of every problem and the formulation, or None to go one by one.
+
+        A law with a vectorized path overrides this; it must give the answer of `_resolve`.
+        """
+        return None
 
 
 def _embed(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outcome:

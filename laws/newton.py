@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.batch import ProblemBatch
 from lawbench.errors import NotApplicable
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
@@ -67,12 +68,33 @@ class Newton(Law):
             Pn = change / np.diag(G)
             formulation = "closed form" if problem.m == 1 else "decoupled (diagonal Delassus)"
         else:
-            Pn, formulation = _solve_dependent(G, change), "linear system"
+            Pn, formulation = _solve_independent(G, change), "linear system"
+            if Pn is None:
+                Pn, formulation = _solve_dependent(G, change), "least squares (dependent contacts)"
         diagnostics = {
             "formulation": formulation,
             "tensile_contacts": [int(j) for j in np.flatnonzero(Pn < 0)],
         }
         return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
+
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """``G Pn = -(1 + E) un-`` for every problem; dependent contacts go one by one."""
+        change = -(1.0 + batch.restitution("newton")) * batch.un
+        Pn = _solve_independent(batch.delassus, change)
+        return None if Pn is None else (Pn, "linear system (batch)")
+
+
+# Condition number past which the contacts count as dependent (redundant).
+DEPENDENT = 1e12
+
+
+def _solve_independent(G: np.ndarray, change: np.ndarray) -> np.ndarray | None:
+    """Solve ``G P = change`` (stacked: ``G`` (..., m, m)) by LU; None if a ``G`` is singular."""
+    if (np.linalg.cond(G) > DEPENDENT).any():
+        return None
+    return np.linalg.solve(G, change[..., None])[..., 0]
 
 
 def _solve_dependent(G: np.ndarray, change: np.ndarray) -> np.ndarray:

@@ -22,10 +22,13 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
+from lawbench.batch import ProblemBatch
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
-from lawbench.solvers import solve_lcp
+from lawbench.solvers import ENUMERATION_MAX, enumerate_lcp, solve_lcp
 from lawbench.tags import Tags
 
 
@@ -48,6 +51,21 @@ class Poisson(Law):
             "compression_impulse": compression.z.tolist(),
         }
         return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
+
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """Both complementarity problems by active-set enumeration, for every problem at once."""
+        if batch.m > ENUMERATION_MAX:
+            return None
+        G, e = batch.delassus, batch.restitution("poisson")
+        compression, found = enumerate_lcp(G, batch.un)
+        slack = np.einsum("kij,kj->ki", G, compression) + batch.un
+        restitution = e * compression
+        expansion, found_too = enumerate_lcp(G, slack + np.einsum("kij,kj->ki", G, restitution))
+        if not (found.all() and found_too.all()):
+            return None
+        return compression + restitution + expansion, "compression and expansion LCPs (batch)"
 
 
 LAWS.register(Poisson())
