@@ -112,15 +112,25 @@ class ProblemBatch:
         scale = np.abs(self.M).max(axis=(1, 2))
         for k in np.flatnonzero(asymmetry > 1e-12 * scale)[:1]:
             raise InvalidProblem(f"problem {k}: M is not symmetric ({asymmetry[k]:.3g})")
-        try:
-            set_(self, "_cholesky", np.linalg.cholesky(self.M))
-        except np.linalg.LinAlgError:
-            k = next(k for k in range(batch) if np.linalg.eigvalsh(self.M[k]).min() <= 0)
-            raise InvalidProblem(f"problem {k}: M is not positive definite") from None
+        # Diagonal mass matrices (particles, chains) are inverted entry by entry, exactly.
+        masses = np.einsum("kii->ki", self.M)
+        diagonal_mass = not (self.M - np.einsum("ki,ij->kij", masses, np.eye(n))).any()
+        smallest = masses.min(axis=1) if diagonal_mass else np.linalg.eigvalsh(self.M)[:, 0]
+        for k in np.flatnonzero(~(smallest > 0))[:1]:
+            raise InvalidProblem(f"problem {k}: M is not positive definite")
+        with np.errstate(all="ignore"):
+            inverse = (
+                np.einsum("ki,ij->kij", 1.0 / masses, np.eye(n))
+                if diagonal_mass
+                else np.linalg.inv(self.M)
+            )
+            set_(self, "_inverse", inverse)
+        for k in np.flatnonzero(~np.isfinite(self._inverse).all(axis=(1, 2)))[:1]:
+            raise InvalidProblem(f"problem {k}: M is too close to singular (its inverse overflows)")
         # The criterion of `ImpactProblem`: a normal Delassus entry at rounding level against
         # the largest inverse mass times the largest squared column of Wn.
         diagonal = np.einsum("kjj->kj", self.delassus)
-        inverse_mass = 1.0 / np.linalg.eigvalsh(self.M)[:, 0]
+        inverse_mass = 1.0 / smallest
         floor = 1e-12 * inverse_mass * (self.Wn**2).sum(axis=1).max(axis=1)
         for k, j in np.argwhere(diagonal <= floor[:, None])[:1]:
             raise InvalidProblem(
@@ -172,11 +182,9 @@ class ProblemBatch:
 
     def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
         """``M^-1 @ rhs`` for every problem (``rhs`` of shape (B, n) or (B, n, k))."""
-        vector = rhs.ndim == 2
-        L = self._cholesky
-        y = np.linalg.solve(L, rhs[..., None] if vector else rhs)
-        x = np.linalg.solve(np.swapaxes(L, 1, 2), y)
-        return x[..., 0] if vector else x
+        if rhs.ndim == 2:
+            return np.einsum("kij,kj->ki", self._inverse, rhs)
+        return self._inverse @ rhs
 
     @cached_property
     def delassus(self) -> np.ndarray:

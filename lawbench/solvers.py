@@ -137,9 +137,22 @@ def _active_sets(m: int) -> tuple[np.ndarray, ...]:
 
 
 def _solve_blocks(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Solve the stacked systems ``A[k] x[k] = b[k]``; a singular block gets its least norm."""
+    """Solve the stacked systems ``A[k] x[k] = b[k]``.
+
+    Blocks of one and two rows by their closed forms (a singular one gives non-finite numbers,
+    which the caller rejects); larger ones by LU, or their least-norm solution when singular.
+    """
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)
+        if A.shape[-1] == 1:
+            return b / A[..., 0]
+        if A.shape[-1] == 2:
+            a, c, d = A[..., 0, 0], A[..., 0, 1], A[..., 1, 1]
+            det = a * d - c * A[..., 1, 0]
+            return (
+                np.stack([(d * b[..., 0] - c * b[..., 1]), (a * b[..., 1] - c * b[..., 0])], -1)
+                / det[..., None]
+            )
         try:
             return np.linalg.solve(A, b[..., None])[..., 0]
         except np.linalg.LinAlgError:
@@ -173,23 +186,23 @@ def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     found = np.zeros(len(qs), dtype=bool)
     velocity_scale = np.maximum(np.abs(qs).max(axis=1, initial=0.0), ROUNDING)
     for active in _active_sets(m):
-        todo = np.flatnonzero(~found)
-        if todo.size == 0:
+        if found.all():
             break
-        candidate = np.zeros((todo.size, m))
+        candidate = np.zeros_like(qs)
         if active.size:
-            block = Gs[todo][:, active[:, None], active]
-            candidate[:, active] = _solve_blocks(block, -qs[todo][:, active])
+            block = Gs[:, active[:, None], active]
+            candidate[:, active] = _solve_blocks(block, -qs[:, active])
         with np.errstate(all="ignore"):
-            slack = np.einsum("kij,kj->ki", Gs[todo], candidate) + qs[todo]
+            slack = np.einsum("kij,kj->ki", Gs, candidate) + qs
             impulse_scale = np.maximum(np.abs(candidate).max(axis=1), ROUNDING)
             good = (
-                np.isfinite(candidate).all(axis=1)
+                ~found
+                & np.isfinite(candidate).all(axis=1)
                 & (candidate.min(axis=1) >= -COMPLEMENTARITY * impulse_scale)
-                & (slack.min(axis=1) >= -COMPLEMENTARITY * velocity_scale[todo])
+                & (slack.min(axis=1) >= -COMPLEMENTARITY * velocity_scale)
             )
-        z[todo[good]] = np.maximum(candidate[good], 0.0)
-        found[todo[good]] = True
+        z[good] = np.maximum(candidate[good], 0.0)
+        found |= good
     return z.reshape(*batch, m), found.reshape(batch)
 
 
