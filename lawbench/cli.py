@@ -194,6 +194,12 @@ def _value(text: str) -> object:
     return numbers if len(parts) > 1 else numbers[0]
 
 
+def _bench(args: argparse.Namespace) -> None:
+    from lawbench.bench import report
+
+    print(report(quick=args.quick))
+
+
 def _regress(args: argparse.Namespace) -> None:
     from lawbench.baselines import regress
 
@@ -283,6 +289,11 @@ def build_parser() -> argparse.ArgumentParser:
     regress.add_argument("--laws", help="comma-separated laws")
     regress.add_argument("--cases", help="comma-separated cases")
     regress.set_defaults(run=_regress)
+    bench = commands.add_parser(
+        "bench", help="time the laws against clarabel and numpy called directly (ratios)"
+    )
+    bench.add_argument("--quick", action="store_true", help="fewer repetitions, smaller sizes")
+    bench.set_defaults(run=_bench)
     return parser
 
 

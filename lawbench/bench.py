@@ -1,0 +1,172 @@
+"""``lawbench bench``: the cost of an answer, as ratios against direct solver calls in one run.
+
+Each figure is the median of several repetitions, measured in this process (or as whole
+processes for the start-up figure), beside a peer measured in the same run: clarabel called
+directly on the same QP (the impulses' LCP as ``min z.G z / 2 + q.z, z >= 0``, sparse), and a
+plain numpy enumeration of the same LCP's active sets. Ratios, not absolute times, are what
+carry from one machine to another. This is a benchmark: nothing here asserts a time.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+import clarabel
+import numpy as np
+import scipy.sparse
+
+from lawbench.api import solve_batch
+from lawbench.batch import ProblemBatch
+from lawbench.law import LAWS
+from lawbench.problem import ImpactProblem
+from lawbench.solvers import clarabel_settings, enumerate_lcp
+
+
+def median_time(function: Callable[[], Any], repeats: int, number: int = 1) -> float:
+    """Median over ``repeats`` of the mean wall time of ``number`` calls, in seconds."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(number):
+            function()
+        times.append((time.perf_counter() - start) / number)
+    return statistics.median(times)
+
+
+def chain_arrays(balls: int, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
+    """Masses, normal Jacobian and velocities of a free chain with every contact approaching."""
+    masses = 10.0 ** rng.uniform(-1.0, 1.0, balls)
+    Wn = np.zeros((balls, balls - 1))
+    index = np.arange(balls - 1)
+    Wn[index, index], Wn[index + 1, index] = -1.0, 1.0
+    v = np.sort(rng.uniform(0.0, 1.0, balls))[::-1].copy()
+    return np.diag(masses), Wn, v
+
+
+def clarabel_direct(M: np.ndarray, Wn: np.ndarray, v: np.ndarray, e: float) -> np.ndarray:
+    """Moreau's frictionless impulses with clarabel, called directly on the sparse LCP's QP."""
+    Wn_sparse = scipy.sparse.csc_matrix(Wn)
+    inverse_mass = scipy.sparse.diags(1.0 / np.diag(M))
+    G = (Wn_sparse.T @ inverse_mass @ Wn_sparse).tocsc()
+    q = (1.0 + e) * (Wn.T @ v)
+    m = Wn.shape[1]
+    solver = clarabel.DefaultSolver(
+        scipy.sparse.triu(G).tocsc(),
+        q,
+        -scipy.sparse.identity(m, format="csc"),
+        np.zeros(m),
+        [clarabel.NonnegativeConeT(m)],
+        clarabel_settings(1e-10, 200),
+    )
+    return np.array(solver.solve().x)
+
+
+def numpy_enumeration(M: np.ndarray, Wn: np.ndarray, v: np.ndarray, e: float) -> np.ndarray:
+    """The same impulses by plain active-set enumeration, with G and q built in numpy."""
+    G = Wn.T @ np.linalg.solve(M, Wn)
+    return enumerate_lcp(G, (1.0 + e) * (Wn.T @ v))[0]
+
+
+def _row(label: str, seconds: float, peers: dict[str, float]) -> str:
+    ratios = ", ".join(f"{seconds / t:.3g}x {name}" for name, t in peers.items())
+    return f"  {label:<46}{_time(seconds):>12}   {ratios}"
+
+
+def _time(seconds: float) -> str:
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.1f} us"
+    return f"{seconds * 1e3:.2f} ms" if seconds < 1 else f"{seconds:.2f} s"
+
+
+def small_impact(repeats: int) -> list[str]:
+    """One three-ball Moreau impact: from a prebuilt problem, and from matrices."""
+    M, Wn, v = chain_arrays(3, np.random.default_rng(0))
+    moreau = LAWS.get("moreau")
+    problem = ImpactProblem.from_arrays(M, Wn, v, e=0.9)
+    peers = {
+        "clarabel direct": median_time(lambda: clarabel_direct(M, Wn, v, 0.9), repeats, 200),
+        "numpy enumeration": median_time(lambda: numpy_enumeration(M, Wn, v, 0.9), repeats, 200),
+    }
+    prebuilt = median_time(lambda: moreau.resolve(problem), repeats, 200)
+    built = median_time(
+        lambda: moreau.resolve(ImpactProblem.from_arrays(M, Wn, v, e=0.9)), repeats, 200
+    )
+    return [
+        "one three-ball Moreau impact (e = 0.9):",
+        _row("lawbench, prebuilt problem", prebuilt, peers),
+        _row("lawbench, from matrices (problem built)", built, peers),
+        *(f"  {name:<46}{_time(t):>12}" for name, t in peers.items()),
+    ]
+
+
+def batch_of_impacts(size: int, repeats: int) -> list[str]:
+    """A batch of random three-ball impacts against the one-by-one path and the peers."""
+    rng = np.random.default_rng(1)
+    masses = 10.0 ** rng.uniform(-1.0, 1.0, (size, 3))
+    M = np.einsum("kn,nl->knl", masses, np.eye(3))
+    _, Wn, _ = chain_arrays(3, rng)
+    v = rng.normal(size=(size, 3))
+    e = rng.uniform(0.0, 1.0, (size, 2))
+    whole = median_time(lambda: solve_batch("moreau", ProblemBatch(M, Wn, v, {"e": e})), repeats)
+    sample = ProblemBatch(M[:200], Wn, v[:200], {"e": e[:200]})
+    moreau = LAWS.get("moreau")
+    one_by_one = (
+        median_time(lambda: [moreau.resolve(sample.problem(k)) for k in range(200)], repeats) / 200
+    )
+    direct = median_time(lambda: clarabel_direct(M[0], Wn, v[0], 0.9), repeats, 200)
+    each = whole / size
+    return [
+        f"a batch of {size:,} random three-ball Moreau impacts (validation included):",
+        _row("lawbench solve_batch, per impact", each, {"one by one": one_by_one}),
+        _row("  against clarabel direct, per call", each, {"clarabel direct": direct}),
+    ]
+
+
+def long_chains(sizes: tuple[int, ...], repeats: int) -> list[str]:
+    """Moreau on n-ball chains against clarabel called directly on the sparse QP."""
+    moreau, lines = LAWS.get("moreau"), ["Moreau on an n-ball chain (e = 0.5):"]
+    for balls in sizes:
+        M, Wn, v = chain_arrays(balls, np.random.default_rng(balls))
+        direct = median_time(lambda M=M, Wn=Wn, v=v: clarabel_direct(M, Wn, v, 0.5), repeats)
+        problem = ImpactProblem.from_arrays(M, Wn, v, e=0.5)
+        ours = median_time(lambda p=problem: moreau.resolve(p), repeats)
+        lines.append(_row(f"n = {balls}, prebuilt problem", ours, {"clarabel direct": direct}))
+    return lines
+
+
+def start_up(repeats: int) -> list[str]:
+    """Whole-process time of a Newton solve against importing numpy alone."""
+    solve = [sys.executable, "-m", "lawbench", "solve", "newton", "three_ball_chain"]
+    numpy_only = [sys.executable, "-c", "import numpy"]
+
+    def run(command: list[str]) -> Callable[[], None]:
+        return lambda: subprocess.run(command, capture_output=True, check=True)
+
+    ours, peer = median_time(run(solve), repeats), median_time(run(numpy_only), repeats)
+    return [
+        "start-up, whole process:",
+        _row("lawbench solve newton three_ball_chain", ours, {'python -c "import numpy"': peer}),
+    ]
+
+
+def report(quick: bool = False) -> str:
+    """Every figure, as text."""
+    repeats = 3 if quick else 7
+    threads = {k: os.environ.get(k, "unset") for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
+    lines = [
+        f"lawbench bench on {os.cpu_count()} cores, {platform.machine()}, Python "
+        f"{platform.python_version()}, numpy {np.__version__}, clarabel {clarabel.__version__}; "
+        + ", ".join(f"{k}={v}" for k, v in threads.items()),
+        *small_impact(repeats),
+        *batch_of_impacts(10_000 if quick else 100_000, repeats),
+        *long_chains((100,) if quick else (100, 1000), repeats),
+        *start_up(repeats),
+    ]
+    return "\n".join(lines)
