@@ -10,6 +10,7 @@ return a non-finite answer.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from abc import ABC, abstractmethod
 from typing import Any, ClassVar
@@ -56,7 +57,9 @@ class Law(ABC):
         InvalidProblem
             For an unknown option name or a bad value.
         """
-        given = dict(given or {})
+        if not given:
+            return dict(self._defaults)
+        given = dict(given)
         specs = {spec.name: spec for spec in self.options}
         unknown = sorted(set(given) - set(specs))
         if unknown:
@@ -65,6 +68,10 @@ class Law(ABC):
                 f"unknown option {unknown[0]!r} for law {self.name!r}; known: {known}"
             )
         return {name: spec.coerce(given.get(name, spec.default)) for name, spec in specs.items()}
+
+    @functools.cached_property
+    def _defaults(self) -> dict[str, Any]:
+        return {spec.name: spec.coerce(spec.default) for spec in self.options}
 
     def resolve(self, problem: ImpactProblem, **options: Any) -> Outcome:
         """Resolve the impact ``problem`` with this law.

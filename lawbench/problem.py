@@ -19,6 +19,8 @@ import scipy.linalg
 from lawbench.errors import InvalidProblem
 
 RESTITUTION_KINDS = ("newton", "poisson", "energy")
+# Up to this many coordinates the inverse of M is kept: a product is cheaper than a solve.
+SMALL = 64
 
 
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
@@ -100,9 +102,8 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
     if array.shape != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
-    bad = np.argwhere(~np.isfinite(array))
-    if bad.size:
-        index = tuple(int(i) for i in bad[0])
+    if not np.isfinite(array).all():
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
         raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
     array.flags.writeable = False
     return array
@@ -182,7 +183,7 @@ class ImpactProblem:
         if asymmetry > 1e-12 * np.abs(self.M).max():
             raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
         try:
-            set_(self, "_cholesky", scipy.linalg.cho_factor(self.M))
+            set_(self, "_cholesky", (np.linalg.cholesky(self.M), True))
         except np.linalg.LinAlgError:
             raise InvalidProblem("M is not positive definite") from None
         self._check_normals()
@@ -251,14 +252,19 @@ class ImpactProblem:
         """
         W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            inverse = self.solve_mass(np.eye(self.n))
+            inverse = scipy.linalg.cho_solve(self._cholesky, np.eye(self.n), check_finite=False)
         if not np.isfinite(inverse).all():
             diagonal = np.diag(self.M)
             raise InvalidProblem(
                 f"M is too close to singular: its inverse overflows (smallest diagonal entry "
                 f"M[{int(np.argmin(diagonal))}, {int(np.argmin(diagonal))}] = {diagonal.min():.3g})"
             )
-        inverse_mass = np.linalg.eigvalsh(inverse).max()
+        if self.n <= SMALL:
+            inverse.flags.writeable = False
+            object.__setattr__(self, "_inverse", inverse)
+        # The largest diagonal entry of M^-1 is within a factor n of its largest eigenvalue:
+        # scale enough for a test at rounding level.
+        inverse_mass = float(np.diag(inverse).max())
         scale = inverse_mass * float((W**2).sum(axis=0).max())
         normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
         for j in np.flatnonzero(normal <= 1e-12 * scale):
@@ -282,7 +288,7 @@ class ImpactProblem:
         """Tangential directions per contact: 0 without friction, 1 planar, 2 spatial."""
         return 0 if self.Wt is None else self.Wt.shape[1] // self.m
 
-    @property
+    @cached_property
     def frictional(self) -> bool:
         """Whether some contact has a tangential Jacobian and a positive mu."""
         return self.Wt is not None and any(c.mu > 0 for c in self.contacts)
@@ -293,8 +299,11 @@ class ImpactProblem:
         return self.gaps <= 0.0
 
     def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
-        """Return ``M^-1 @ rhs`` through the cached Cholesky factor."""
-        return scipy.linalg.cho_solve(self._cholesky, rhs)
+        """Return ``M^-1 @ rhs``: the cached inverse of a small M, else its Cholesky factor."""
+        inverse = self.__dict__.get("_inverse")
+        if inverse is not None:
+            return inverse @ rhs
+        return scipy.linalg.cho_solve(self._cholesky, rhs, check_finite=False)
 
     @cached_property
     def delassus(self) -> np.ndarray:
@@ -331,14 +340,26 @@ class ImpactProblem:
         """Pre-impact tangential slip velocities ``Wt.T @ v`` (m*d,); empty without Wt."""
         return np.zeros(0) if self.Wt is None else self.Wt.T @ self.v
 
-    @property
+    @cached_property
     def mu(self) -> np.ndarray:
         """Friction coefficients, one per contact."""
-        return np.array([c.mu for c in self.contacts])
+        mu = np.array([c.mu for c in self.contacts])
+        mu.flags.writeable = False
+        return mu
 
     def restitution(self, kind: str) -> np.ndarray:
         """Per-contact restitution coefficients of ``kind`` ('newton', 'poisson', 'energy')."""
-        return np.array([c.restitution(kind) for c in self.contacts])
+        if kind not in RESTITUTION_KINDS:
+            raise ValueError(f"unknown restitution kind {kind!r}")
+        return self._restitutions[kind]
+
+    @cached_property
+    def _restitutions(self) -> dict[str, np.ndarray]:
+        coefficients = {}
+        for kind in RESTITUTION_KINDS:
+            coefficients[kind] = np.array([c.restitution(kind) for c in self.contacts])
+            coefficients[kind].flags.writeable = False
+        return coefficients
 
     def select_contacts(self, mask: np.ndarray) -> ImpactProblem:
         """Return the problem restricted to the contacts where ``mask`` is true."""

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import math
 import warnings
 from dataclasses import dataclass
 
@@ -179,6 +180,8 @@ def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
         so a problem without one is numerically singular and the caller solves it otherwise.
     """
     q = np.asarray(q, dtype=float)
+    if q.ndim == 1 and np.ndim(G) == 2:
+        return _enumerate_one(np.asarray(G, dtype=float), q)
     batch, m = q.shape[:-1], q.shape[-1]
     qs = q.reshape(-1, m)
     Gs = np.broadcast_to(np.asarray(G, dtype=float), (*batch, m, m)).reshape(-1, m, m)
@@ -204,6 +207,47 @@ def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
         z[good] = np.maximum(candidate[good], 0.0)
         found |= good
     return z.reshape(*batch, m), found.reshape(batch)
+
+
+def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`enumerate_lcp` for one problem, in Python floats: the same sets, formulas and tests.
+
+    One problem of a few contacts is dominated by the cost of calling numpy, so the blocks of
+    one and two rows are solved with the same closed forms in plain arithmetic (identical in
+    IEEE double), and only larger blocks go through LU.
+    """
+    m = len(q)
+    rows, rhs = G.tolist(), q.tolist()
+    velocity_scale = max(max(abs(x) for x in rhs), ROUNDING)
+    for active in _active_sets(m):
+        candidate = [0.0] * m
+        if len(active) == 1:
+            (i,) = active
+            candidate[i] = -rhs[i] / rows[i][i] if rows[i][i] else math.inf
+        elif len(active) == 2:
+            i, j = active
+            a, c, d, c2 = rows[i][i], rows[i][j], rows[j][j], rows[j][i]
+            det = a * d - c * c2
+            if det == 0.0:
+                continue
+            candidate[i] = (d * -rhs[i] - c * -rhs[j]) / det
+            candidate[j] = (a * -rhs[j] - c * -rhs[i]) / det
+        elif len(active) > 2:
+            solved = _solve_blocks(G[np.ix_(active, active)][None], -q[active][None])[0]
+            for i, x in zip(active.tolist(), solved.tolist(), strict=True):
+                candidate[i] = x
+        if not all(math.isfinite(x) for x in candidate):
+            continue
+        impulse_scale = max(max(abs(x) for x in candidate), ROUNDING)
+        if min(candidate) < -COMPLEMENTARITY * impulse_scale:
+            continue
+        slack = [
+            sum(g * x for g, x in zip(row, candidate, strict=True)) + b
+            for row, b in zip(rows, rhs, strict=True)
+        ]
+        if min(slack) >= -COMPLEMENTARITY * velocity_scale:
+            return np.maximum(np.array(candidate), 0.0), np.array(True)
+    return np.zeros(m), np.array(False)
 
 
 def solve_lcp(
