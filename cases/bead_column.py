@@ -23,7 +23,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from lawbench.case import CASES, Case, GroundTruth, Params, per_item
+from lawbench.cases._ground_truths import SPRING_CHAIN
+
+from lawbench.case import CASES, Case, Params, per_item
 from lawbench.chains import ball_velocities, chain_problem, restitution_spec
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
@@ -51,13 +53,7 @@ class BeadColumn(Case):
         restitution_spec(),
     )
     requires = Tags(several_contacts=True, stiffness=True)
-    ground_truth = GroundTruth(
-        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
-        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
-        "limits of the three-ball chain)",
-        law="compliant",
-        options={"rtol": 1e-10},
-    )
+    ground_truth = SPRING_CHAIN
     examples = {"default": {}, "one bead": {"n": 1}, "higher drop": {"drop_height": 5.1e-3}}
 
     def _check(self, params: dict[str, Any]) -> None:

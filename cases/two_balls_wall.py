@@ -14,8 +14,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.cases._ground_truths import SPRING_CHAIN
 
-from lawbench.case import CASES, Case, GroundTruth, Params, Reference, exactly, per_item
+from lawbench.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.chains import (
     ball_velocities,
     chain_problem,
@@ -99,13 +100,7 @@ class TwoBallsWall(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
-    ground_truth = GroundTruth(
-        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
-        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
-        "limits of the three-ball chain)",
-        law="compliant",
-        options={"rtol": 1e-10},
-    )
+    ground_truth = SPRING_CHAIN
     references = (
         Reference(
             "eq. (27)",
