@@ -2,8 +2,10 @@
 
 Each figure is the median of several repetitions, measured in this process (or as whole
 processes for the start-up figure), beside a peer measured in the same run: clarabel called
-directly on the same QP (the impulses' LCP as ``min z.G z / 2 + q.z, z >= 0``, sparse), and a
-plain numpy enumeration of the same LCP's active sets. Ratios, not absolute times, are what
+directly on the same QP (the impulses' LCP as ``min z.G z / 2 + q.z, z >= 0``, sparse), a
+plain numpy enumeration of the same LCP's active sets, and Siconos numerics' Lemke solver where
+it is installed (``LAWBENCH_SICONOS_PYTHON``, default ``/usr/bin/python3`` with Debian's
+python3-siconos). Ratios, not absolute times, are what
 carry from one machine to another. This is a benchmark: nothing here asserts a time.
 """
 
@@ -74,6 +76,40 @@ def numpy_enumeration(M: np.ndarray, Wn: np.ndarray, v: np.ndarray, e: float) ->
     return enumerate_lcp(G, (1.0 + e) * (Wn.T @ v))[0]
 
 
+# Siconos numerics (the reference nonsmooth-mechanics library, C) is measured when the
+# interpreter below imports it (Debian: python3-siconos): Lemke on the same three-ball LCP,
+# building its matrix and vector included, one call at a time.
+SICONOS_PYTHON = os.environ.get("LAWBENCH_SICONOS_PYTHON", "/usr/bin/python3")
+SICONOS_SCRIPT = """
+import time, numpy as np, siconos.numerics as sn
+masses, v, e = np.array({masses}), np.array({v}), 0.9
+Wn = np.zeros((3, 2)); Wn[[0, 1], [0, 1]] = -1.0; Wn[[1, 2], [0, 1]] = 1.0
+def one():
+    D = Wn.T @ (Wn / masses[:, None]); q = (1.0 + e) * (Wn.T @ v)
+    z, w = np.zeros(2), np.zeros(2)
+    sn.lcp_lexicolemke(sn.LCP(D, q), z, w, sn.SolverOptions(sn.SICONOS_LCP_LEMKE))
+    return z
+times = []
+for _ in range({repeats}):
+    start = time.perf_counter()
+    for _ in range(200): one()
+    times.append((time.perf_counter() - start) / 200)
+print(sorted(times)[len(times) // 2])
+"""
+
+
+def siconos_lemke(masses: np.ndarray, v: np.ndarray, repeats: int) -> float | None:
+    """Median seconds per three-ball Lemke solve in Siconos numerics, or None if absent."""
+    script = SICONOS_SCRIPT.format(masses=masses.tolist(), v=v.tolist(), repeats=repeats)
+    try:
+        done = subprocess.run(
+            [SICONOS_PYTHON, "-c", script], capture_output=True, text=True, timeout=120
+        )
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return float(done.stdout) if done.returncode == 0 else None
+
+
 def _row(label: str, seconds: float, peers: dict[str, float]) -> str:
     ratios = ", ".join(f"{seconds / t:.3g}x {name}" for name, t in peers.items())
     return f"  {label:<46}{_time(seconds):>12}   {ratios}"
@@ -94,6 +130,9 @@ def small_impact(repeats: int) -> list[str]:
         "clarabel direct": median_time(lambda: clarabel_direct(M, Wn, v, 0.9), repeats, 200),
         "numpy enumeration": median_time(lambda: numpy_enumeration(M, Wn, v, 0.9), repeats, 200),
     }
+    siconos = siconos_lemke(np.diag(M), v, repeats)
+    if siconos is not None:
+        peers["Siconos Lemke"] = siconos
     prebuilt = median_time(lambda: moreau.resolve(problem), repeats, 200)
     built = median_time(
         lambda: moreau.resolve(ImpactProblem.from_arrays(M, Wn, v, e=0.9)), repeats, 200
@@ -103,6 +142,7 @@ def small_impact(repeats: int) -> list[str]:
         _row("lawbench, prebuilt problem", prebuilt, peers),
         _row("lawbench, from matrices (problem built)", built, peers),
         *(f"  {name:<46}{_time(t):>12}" for name, t in peers.items()),
+        *([] if siconos is not None else ["  Siconos numerics: not found (python3-siconos)"]),
     ]
 
 
@@ -120,12 +160,16 @@ def batch_of_impacts(size: int, repeats: int) -> list[str]:
     one_by_one = (
         median_time(lambda: [moreau.resolve(sample.problem(k)) for k in range(200)], repeats) / 200
     )
-    direct = median_time(lambda: clarabel_direct(M[0], Wn, v[0], 0.9), repeats, 200)
-    each = whole / size
+    peers = {
+        "one by one": one_by_one,
+        "clarabel direct": median_time(lambda: clarabel_direct(M[0], Wn, v[0], 0.9), repeats, 200),
+    }
+    siconos = siconos_lemke(masses[0], v[0], repeats)
+    if siconos is not None:
+        peers["Siconos Lemke one by one"] = siconos
     return [
         f"a batch of {size:,} random three-ball Moreau impacts (validation included):",
-        _row("lawbench solve_batch, per impact", each, {"one by one": one_by_one}),
-        _row("  against clarabel direct, per call", each, {"clarabel direct": direct}),
+        _row("lawbench solve_batch, per impact", whole / size, peers),
     ]
 
 
