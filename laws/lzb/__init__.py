@@ -113,10 +113,10 @@ from typing import Any
 
 import numpy as np
 import scipy.special
+from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 from lawbench import budget
 from lawbench.law import LAWS, Law
-from lawbench.lzb_dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem

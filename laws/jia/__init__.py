@@ -4,7 +4,7 @@ Source: Y.-B. Jia, *Three-dimensional impact: energy-based modeling of tangentia
 Int. J. Robotics Research 32(1), 2013, and Y.-B. Jia, M. T. Mason, M. A. Erdmann, *Multiple
 impacts: a state transition diagram approach*, IJRR 32(1), 2013, as presented in Jia's talk
 *Simultaneous three-dimensional impacts with friction and compliance* (2012). The equations and
-their integration are in `lawbench.jia_dynamics`.
+their integration are in `lawbench.laws.jia.dynamics`.
 
 - One contact: the contact point is a massless particle held by a normal spring and two
   tangential springs. The normal impulse drives the impact: the normal strain energy obeys
@@ -32,7 +32,7 @@ their integration are in `lawbench.jia_dynamics`.
   with the compression (what the tangential springs hold is lost). In a chain, a contact held
   loaded by its neighbours can end compression, empty and return without end, its stiffness
   growing each time; that infinite sequence, and e = 0, are treated as their limit, a rigid
-  plastic contact that holds its gap rate while it pushes (`lawbench.jia_dynamics`, LOCK).
+  plastic contact that holds its gap rate while it pushes (`lawbench.laws.jia.dynamics`, LOCK).
 
 Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart; ``Pt`` is the tangential impulse
 in the columns of ``Wt`` (``|Pt| <= mu Pn`` holds along the whole impact, and ``Pt`` opposes
@@ -57,9 +57,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.laws.jia.dynamics import SpringImpact, Springs
 
 from lawbench.errors import NotApplicable
-from lawbench.jia_dynamics import SpringImpact, Springs
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome

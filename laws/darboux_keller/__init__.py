@@ -23,7 +23,7 @@ normal-tangential coupling; in 3D ``mu >= |Gtt^-1 Gtn|``); otherwise the slip re
 Spatial slip with a turning direction is integrated with ``solve_ivp`` (Radau, option
 ``rtol``, the accuracy knob) until it stops; the rest is exact again: stick, or slip in a
 fixed direction (Darboux's proposition, lectures after eq. 15). The machinery is in
-`lawbench.impulse_dynamics`.
+`lawbench.laws.darboux_keller.dynamics`.
 
 When friction stops slip and the stuck contact's impulse no longer moves the system (the
 lamina on an anvil with ``mu |h0| >= |f0|``) the restitution cannot start and the impact ends
@@ -59,8 +59,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.laws.darboux_keller.dynamics import (
+    ImpactRecord,
+    SingleContactImpact,
+    State,
+    path_arrays,
+)
 
-from lawbench.impulse_dynamics import ImpactRecord, SingleContactImpact, State, path_arrays
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
