@@ -14,5 +14,5 @@ SPRING_CHAIN = GroundTruth(
     "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
     "limits of the three-ball chain)",
     law="compliant",
-    options={"rtol": 1e-10},
+    options={"tol": 1e-10},
 )

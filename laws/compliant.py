@@ -29,11 +29,11 @@ Numerics: scipy's ``solve_ivp`` (DOP853 by default) in scaled variables (velocit
 largest approach speed V, lengths over the largest static indentation scale, time over their
 ratio), restarted at every event where a force law changes branch (a contact closes, opens,
 or its force crosses zero), so the right-hand side is smooth between restarts. The impact ends
-when every contact is open and none approaches. The accuracy knob is ``rtol`` (atol = rtol
+when every contact is open and none approaches. The accuracy knob is ``tol`` (atol = tol
 times 1e-3 in scaled units). Order of convergence: the error of ``v_plus`` against a
-tight-tolerance reference falls in proportion to rtol (slope 1 in log-log; on the three-ball
-chain it stays between 0.01 and 0.2 times rtol from 1e-3 to 1e-10, tested), while DOP853's
-step count grows only as about rtol^(-1/8). Budgets: ``max_steps`` solver steps and
+tight-tolerance reference falls in proportion to tol (slope 1 in log-log; on the three-ball
+chain it stays between 0.01 and 0.2 times tol from 1e-3 to 1e-10, tested), while DOP853's
+step count grows only as about tol^(-1/8). Budgets: ``max_steps`` solver steps and
 ``max_events`` restarts and ``max_seconds`` of wall-clock time, each raising `SolverFailure`
 naming what ran out.
 """
@@ -107,11 +107,11 @@ class Compliant(Law):
         "time integration of unilateral compliant contacts (Kelvin-Voigt, Hertz, Hunt-Crossley)"
     )
     source = "Brogliato 2010, compliant contacts; Hunt and Crossley 1975; Flores et al. 2011"
-    tags = Tags(several_contacts=True, stiffness=True, accuracy_knob="rtol")
+    tags = Tags(several_contacts=True, stiffness=True, accuracy_knob="tol")
     follows_gaps = True
     options = (
         Spec("model", "hunt_crossley", "force law of every contact", kind="str", choices=MODELS),
-        Spec("rtol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),
+        Spec("tol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),
         Spec(
             "termination",
             "force",
@@ -238,7 +238,7 @@ class _Integration:
         problem, options = self.problem, self.options
         y = np.concatenate([problem.gaps / self.L, problem.v / self.V, np.zeros(problem.m)])
         method = getattr(scipy.integrate, options["method"])
-        rtol = options["rtol"]
+        rtol = options["tol"]
         t, steps, restarts = 0.0, 0, 0
         peak = np.zeros(problem.m)
         history: list[tuple[float, np.ndarray]] = [(0.0, y)]

@@ -56,7 +56,7 @@ matrix, ``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clar
   have several solutions or none when normal and tangential directions are strongly coupled,
   and even where it has one the plain iterates can cycle between two values; past 20 steps the
   update is averaged (``s <- (s + mu |ut+|) / 2``), which breaks such cycles. More than
-  ``max_fixed_point`` steps raise `SolverFailure` with the count.
+  ``max_steps`` steps raise `BudgetExceeded` with the count.
 - ``relaxed`` ("SOCP relaxed (clarabel)"): one convex problem with ``s = 0``, Anitescu's
   relaxation. Its conditions are ``un+_j + e_j r_j >= mu_j |ut+_j|`` instead of ``>= 0``: a
   slipping contact leaves with the extra normal rate ``mu_j |ut+_j|`` (it may separate where
@@ -148,7 +148,7 @@ class Moreau(Law):
             choices=("coulomb", "relaxed"),
         ),
         Spec(
-            "max_fixed_point",
+            "max_steps",
             1000,
             "bound on the cone QPs of the exact Coulomb law's fixed point",
             "",
@@ -260,11 +260,11 @@ def _resolve_friction(
         # Plain substitution first; past UNDAMPED steps average, which breaks the two-cycles
         # the plain iteration can fall into.
         s = s + (1.0 if steps < UNDAMPED else 0.5) * (target - s)
-        if steps >= options["max_fixed_point"]:
+        if steps >= options["max_steps"]:
             raise BudgetExceeded(
                 f"moreau: the Coulomb fixed point did not converge in {steps} steps "
-                f"(last change of mu |ut+| {change:.3g}, tolerance {tol:g}, max_fixed_point)",
-                "max_fixed_point",
+                f"(last change of mu |ut+| {change:.3g}, tolerance {tol:g}, max_steps)",
+                "max_steps",
                 steps,
             )
     if exact and options["polish"]:

@@ -14,7 +14,7 @@ over the contacts by increasing index (``left_to_right``) or decreasing index
 strikes none; or always the fastest approaching contact (``fastest_first``, ties to the lowest
 index). The sequence of binary
 impacts is in ``diagnostics['sequence']`` (the first 10 000; ``diagnostics['impacts']`` counts
-them all, and the option ``path`` returns the velocity after each). More than ``max_impacts``
+them all, and the option ``path`` returns the velocity after each). More than ``max_steps``
 raise `SolverFailure` with the count: with small e a chain can need infinitely many impacts
 (inelastic collapse, McNamara and Young, Phys. Fluids A 4, 1992), and the sequence only ends
 here because approach speeds below the tolerance count as rest.
@@ -54,12 +54,12 @@ class Sequential(Law):
             "str",
             choices=ORDERS,
         ),
-        Spec("max_impacts", 1_000_000, "bound on the number of binary impacts", "", "int", 1),
+        Spec("max_steps", 1_000_000, "bound on the number of binary impacts", "", "int", 1),
         Spec("path", False, "return the velocities after each binary impact", "", "bool"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
-        impacts = _BinaryImpacts(problem, options["max_impacts"])
+        impacts = _BinaryImpacts(problem, options["max_steps"])
         if options["order"] == "fastest_first":
             while impacts.un.min() < impacts.threshold:
                 impacts.strike(int(np.argmin(impacts.un)))
@@ -104,9 +104,9 @@ class _BinaryImpacts:
         if len(self.contacts) == self.max_impacts:
             raise BudgetExceeded(
                 f"sequential: contacts still approach after {len(self.contacts)} binary impacts "
-                f"(max_impacts = {self.max_impacts}; a sequence that does not end, such as an "
+                f"(max_steps = {self.max_impacts}; a sequence that does not end, such as an "
                 "inelastic collapse)",
-                "max_impacts",
+                "max_steps",
                 self.max_impacts,
             )
         impulse = -(1.0 + self.e[j]) * self.un[j] / self.G[j, j]

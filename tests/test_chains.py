@@ -144,7 +144,7 @@ def test_sequential_ends_with_no_contact_approaching(order):
 def test_sequential_reports_an_endless_sequence():
     """Two balls falling on a wall with e=0 need ever more impacts: a clear SolverFailure."""
     with pytest.raises(lawbench.SolverFailure, match="after 5 binary impacts"):
-        lawbench.solve("sequential", "two_balls_wall", {"max_impacts": 5}, e=0)
+        lawbench.solve("sequential", "two_balls_wall", {"max_steps": 5}, e=0)
 
 
 def test_sequential_geometric_sequence_ends():

@@ -333,14 +333,14 @@ def test_main_returns_the_usage_exit_code_instead_of_raising(capsys):
 
 def test_solver_failure_exits_4_with_one_line():
     result = run_lawbench(
-        "solve", "sequential", "two_balls_wall", "--set", "e=0", "--option", "max_impacts=5"
+        "solve", "sequential", "two_balls_wall", "--set", "e=0", "--option", "max_steps=5"
     )
     line = assert_one_line_error(result, 4)
     assert "5" in line
 
 
 def test_same_scene_without_the_impact_bound_succeeds():
-    # The failure above comes from max_impacts, not from the scene.
+    # The failure above comes from max_steps, not from the scene.
     record = solve_json("sequential", "two_balls_wall", "--set", "e=0")
     assert set(record) == RECORD_KEYS
     assert record["diagnostics"]["impacts"] > 5

@@ -356,10 +356,9 @@ def test_infinitely_stiff_tangential_springs_give_rigid_rolling():
 def test_tolerance_converges():
     """The accuracy knob: the answer approaches a tight reference as the tolerance shrinks."""
     problem = BALL.build(angular_velocity=[0.0, -2.0, 0.0])
-    reference = LAW.resolve(problem, tolerance=1e-13).v_plus
+    reference = LAW.resolve(problem, tol=1e-13).v_plus
     errors = [
-        np.abs(LAW.resolve(problem, tolerance=tol).v_plus - reference).max()
-        for tol in (1e-5, 1e-7, 1e-9)
+        np.abs(LAW.resolve(problem, tol=tol).v_plus - reference).max() for tol in (1e-5, 1e-7, 1e-9)
     ]
     assert errors[0] > errors[1] > errors[2]
     assert errors[2] < 1e-7

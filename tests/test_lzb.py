@@ -14,7 +14,7 @@ STEEL_MASS, STEEL_STIFFNESS = 2.05e-3, 6.9716e9
 
 
 def compliant(case, **params):
-    return lawbench.solve("compliant", case, {"model": "hertz", "rtol": 1e-12}, **params)
+    return lawbench.solve("compliant", case, {"model": "hertz", "tol": 1e-12}, **params)
 
 
 def cycles(outcome):
@@ -93,7 +93,7 @@ def test_two_balls_on_a_wall_differ_from_the_springs_when_the_wall_contact_comes
     params = {"stiffness_ratio": 10.0, "exponent": exponent}
     outcome = lawbench.solve("lzb", "two_balls_wall", **params)
     springs = lawbench.solve(
-        "compliant", "two_balls_wall", {"model": "hertz", "rtol": 1e-12, "path": True}, **params
+        "compliant", "two_balls_wall", {"model": "hertz", "tol": 1e-12, "path": True}, **params
     )
     wall = springs.path["force"][:, 1] > 0
     assert np.count_nonzero(np.diff(wall.astype(int)) == 1) >= 1  # the wall contact reopened
@@ -210,7 +210,7 @@ def test_bead_column_peak_wall_force(drop_height):
     """
     peaks = [
         lawbench.solve(
-            "lzb", "bead_column", {"rtol": 1e-6}, n=n, drop_height=drop_height
+            "lzb", "bead_column", {"tol": 1e-6}, n=n, drop_height=drop_height
         ).diagnostics["peak_force"][0]
         for n in (1, 2, 5, 10)
     ]
@@ -225,7 +225,7 @@ def test_bead_column_peak_wall_force_up_to_forty_beads(drop_height):
     """As above, the whole range of the experiment, 1 to 40 beads."""
     peaks = [
         lawbench.solve(
-            "lzb", "bead_column", {"rtol": 1e-6}, n=n, drop_height=drop_height
+            "lzb", "bead_column", {"tol": 1e-6}, n=n, drop_height=drop_height
         ).diagnostics["peak_force"][0]
         for n in (1, 2, 3, 5, 10, 20, 40)
     ]
@@ -240,7 +240,7 @@ def test_bead_column_wall_force_oscillates_with_the_measured_period():
     The path gives the springs' time; the maxima of the wall force are its ends of
     compression. Ten beads; measured median interval 32.9 microseconds.
     """
-    outcome = lawbench.solve("lzb", "bead_column", {"rtol": 1e-6, "path": True}, n=10)
+    outcome = lawbench.solve("lzb", "bead_column", {"tol": 1e-6, "path": True}, n=10)
     path = outcome.path
     t, force, un = path["t"], path["force"][:, 0], path["un"][:, 0]
     turns = np.flatnonzero((un[:-1] < 0) & (un[1:] >= 0)) + 1
@@ -258,10 +258,10 @@ def test_error_falls_in_proportion_to_rtol():
     0.94 on two balls and a wall with e* < 1).
     """
     for case, params in [("three_ball_chain", {}), ("two_balls_wall", {"e": [0.6, 0.9]})]:
-        reference = lawbench.solve("lzb", case, {"rtol": 1e-13}, **params).v_plus
+        reference = lawbench.solve("lzb", case, {"tol": 1e-13}, **params).v_plus
         tolerances = np.logspace(-3, -10, 8)
         errors = [
-            np.abs(lawbench.solve("lzb", case, {"rtol": r}, **params).v_plus - reference).max()
+            np.abs(lawbench.solve("lzb", case, {"tol": r}, **params).v_plus - reference).max()
             for r in tolerances
         ]
         slope = np.polyfit(np.log(tolerances), np.log(errors), 1)[0]
@@ -491,4 +491,4 @@ def test_path_and_diagnostics():
     np.testing.assert_allclose(diagnostics["peak_force"], path["force"].max(axis=0), rtol=1e-9)
     assert diagnostics["steps"] == diagnostics["impulse_steps"] + diagnostics["time_steps"]
     assert diagnostics["impulse_steps"] > diagnostics["time_steps"]
-    assert diagnostics["variant"] == "bi" and diagnostics["rtol"] == 1e-10
+    assert diagnostics["variant"] == "bi" and diagnostics["tol"] == 1e-10

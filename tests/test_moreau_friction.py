@@ -353,7 +353,7 @@ def test_averaged_fixed_point_breaks_a_cycle():
     solutions = planar_solutions(problem)
     assert len(solutions) == 1
     with pytest.raises(lawbench.SolverFailure, match="did not converge in 20 steps"):
-        MOREAU.resolve(problem, max_fixed_point=20)
+        MOREAU.resolve(problem, max_steps=20)
     outcome = MOREAU.resolve(problem)
     assert outcome.diagnostics["fixed_point_steps"] > 20
     np.testing.assert_allclose(
@@ -366,9 +366,9 @@ def test_fixed_point_steps_are_bounded_and_reported():
     problem = random_problem(1, 2)
     steps = MOREAU.resolve(problem).diagnostics["fixed_point_steps"]
     assert 2 < steps <= 1000
-    assert MOREAU.resolve(problem, max_fixed_point=steps).diagnostics["iterations"] > steps
+    assert MOREAU.resolve(problem, max_steps=steps).diagnostics["iterations"] > steps
     with pytest.raises(lawbench.SolverFailure, match=f"did not converge in {steps - 1} steps"):
-        MOREAU.resolve(problem, max_fixed_point=steps - 1)
+        MOREAU.resolve(problem, max_steps=steps - 1)
 
 
 def test_options_and_tags():

@@ -106,7 +106,7 @@ def test_sequential_impacts_dissipate_or_report_a_collapse(approaching):
     for seed in SEEDS:
         _, problem = random_chain(seed, approaching=approaching)
         try:
-            outcome = law.resolve(problem, max_impacts=200_000)
+            outcome = law.resolve(problem, max_steps=200_000)
         except lawbench.SolverFailure as failure:
             assert "binary impacts" in str(failure)
             continue

@@ -95,7 +95,7 @@ def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
                     "laws": ["sequential"],
                     "cases": ["two_balls_wall"],
                     "params": {"e": [0.0, 0.5]},
-                    "options": {"sequential": {"max_impacts": [5]}},
+                    "options": {"sequential": {"max_steps": [5]}},
                 }
             ]
         }

@@ -48,7 +48,7 @@ class Config:
     knob_values : tuple of float
         Values a numeric accuracy knob is swept over (those its spec accepts).
     reference_knob : float
-        The tightest value of a numeric knob: the compliant reference's rtol, and a law's own
+        The tightest value of a numeric knob: the compliant reference's tol, and a law's own
         reference when the compliant model cannot treat the scene.
     repeats : int
         Solves per point of the speed/accuracy study (the median wall time is kept).

@@ -21,7 +21,7 @@ and work quadratic in ``Pn``, slip stop, end of compression and termination at c
 roots. Stick, once reached, lasts when ``mu >= |Gtn / Gtt|`` (friction strong against the
 normal-tangential coupling; in 3D ``mu >= |Gtt^-1 Gtn|``); otherwise the slip reverses.
 Spatial slip with a turning direction is integrated with ``solve_ivp`` (Radau, option
-``rtol``, the accuracy knob) until it stops; the rest is exact again: stick, or slip in a
+``tol``, the accuracy knob) until it stops; the rest is exact again: stick, or slip in a
 fixed direction (Darboux's proposition, lectures after eq. 15). The machinery is in
 `lawbench.laws.darboux_keller.dynamics`.
 
@@ -85,7 +85,7 @@ class DarbouxKeller(Law):
         "Newton, Poisson or Stronge termination"
     )
     source = "Darboux 1880, Keller 1986, Stronge 1990; Brogliato 2010, eqs. (2)-(4), (12)-(15)"
-    tags = Tags(friction=True, several_contacts=False, spatial=True, accuracy_knob="rtol")
+    tags = Tags(friction=True, several_contacts=False, spatial=True, accuracy_knob="tol")
     options = (
         Spec(
             "termination",
@@ -96,7 +96,7 @@ class DarbouxKeller(Law):
             choices=tuple(COEFFICIENT),
         ),
         Spec(
-            "rtol",
+            "tol",
             1e-9,
             "relative tolerance of the ODE of turning spatial slip (planar problems are exact)",
             "",
@@ -127,7 +127,7 @@ class DarbouxKeller(Law):
         else:
             e = contact.restitution(COEFFICIENT[termination])
             impact = SingleContactImpact(
-                problem.contact_delassus, u_minus, mu, termination, e, options["rtol"]
+                problem.contact_delassus, u_minus, mu, termination, e, options["tol"]
             )
             final, record = impact.run(), impact.record
             compression = record.compression

@@ -89,11 +89,11 @@ class Jia(Law):
         several_contacts=True,
         spatial=True,
         stiffness=True,
-        accuracy_knob="tolerance",
+        accuracy_knob="tol",
     )
     options = (
         Spec(
-            "tolerance",
+            "tol",
             1e-11,
             "relative tolerance of the integration along the impact",
             "",
@@ -141,7 +141,7 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
         G, u_minus = problem.contact_delassus, np.concatenate([problem.un, problem.ut])
     else:
         G, u_minus = problem.delassus, problem.un
-    impact = SpringImpact(G, u_minus, springs, options["tolerance"], options["path"])
+    impact = SpringImpact(G, u_minus, springs, options["tol"], options["path"])
     state = impact.run()
     record = impact.record
     if d:

@@ -32,7 +32,7 @@ summed over the cycle.
   compression; the two agree unless a contact is compressed again within a cycle.
 
 The impact ends when every stored energy is released and no contact approaches. A gap rate
-above ``-10 rtol V`` (``V`` the largest pre-impact contact speed) counts as rest, normal or
+above ``-10 tol V`` (``V`` the largest pre-impact contact speed) counts as rest, normal or
 tangential: closer to zero it is within the integrator's error. Coulomb friction (planar,
 d = 1; Zhang et al. 2013): a loaded contact that slips has ``dPt_j = -mu_j dPn_j sign(ut_j)``;
 one at rest sticks (``dut_j = 0``) when the tangential forces this needs lie in the cones, and
@@ -56,17 +56,17 @@ the start and the end of the loadings). The primary changes, as an event, when a
 stores more energy (ties within 1e-6 relative keep the current one).
 
 Energy and accuracy. The equations keep ``T + sum_j E_j`` exactly (e* = 1, no friction); they
-are integrated by scipy's DOP853 (option ``method``) at relative tolerance ``rtol``, the
-accuracy knob (absolute tolerance ``1e-3 rtol`` in units of ``V``, of the smallest indentation
+are integrated by scipy's DOP853 (option ``method``) at relative tolerance ``tol``, the
+accuracy knob (absolute tolerance ``1e-3 tol`` in units of ``V``, of the smallest indentation
 scale and of their impulse and energy), restarted at every event (end of compression,
 recompression, end of a cycle, approach of an idle contact, slip stop, stick limit, change of
 primary contact or of variable), each located by Brent's method on the dense output to
 rounding, so the right-hand side is smooth within a segment. Three steel balls at e* = 1 (the
 Falcon beads, one striking two at rest) keep their kinetic energy to 2.5e-11 relative at the
-default ``rtol = 1e-10`` (1e-9 at 1e-8, 7e-8 at 1e-6). Order of convergence: the error of
-``v_plus`` against a tight-tolerance reference falls in proportion to ``rtol`` (fitted slope
-1.01 on the three-ball chain, 0.94 on two balls and a wall, rtol 1e-3 to 1e-10; tested), while
-the step count grows only about as ``rtol^(-1/12)``.
+default ``tol = 1e-10`` (1e-9 at 1e-8, 7e-8 at 1e-6). Order of convergence: the error of
+``v_plus`` against a tight-tolerance reference falls in proportion to ``tol`` (fitted slope
+1.01 on the three-ball chain, 0.94 on two balls and a wall, tol 1e-3 to 1e-10; tested), while
+the step count grows only about as ``tol^(-1/12)``.
 
 Relation with compliant contacts: with e* = 1 the law is the time integration of the same
 unilateral springs (same stiffness ratios, exponents and masses) at a frozen configuration,
@@ -96,7 +96,7 @@ is diagonal and no path is asked (each contact is Stronge's single impact,
 ``Pn_j = -(1 + e*_j) un_j / G_jj``); ``"no approaching contact"``; otherwise
 ``"energetic impulse dynamics (...)"``.
 
-Diagnostics: ``formulation``, ``variant``, ``rtol``, ``steps`` (``impulse_steps`` +
+Diagnostics: ``formulation``, ``variant``, ``tol``, ``steps`` (``impulse_steps`` +
 ``time_steps``), ``events``, ``peak_force`` (N, per contact: ``K d^eta`` at the largest
 ``d = ((eta+1) E / K)^(1/(eta+1))``), ``primary_switches`` and ``primaries`` (the successive
 primary contacts, the first 1000), ``cycles`` (per contact, one ``{"compression",
@@ -133,7 +133,7 @@ class LiuZhaoBrogliato(Law):
         "ratios and stored energies, Stronge's coefficient per contact"
     )
     source = "Brogliato 2010, eqs. (32)-(48); Liu, Zhao, Brogliato 2008, 2009; Zhang et al. 2013"
-    tags = Tags(friction=True, several_contacts=True, stiffness=True, accuracy_knob="rtol")
+    tags = Tags(friction=True, several_contacts=True, stiffness=True, accuracy_knob="tol")
     options = (
         Spec(
             "variant",
@@ -142,7 +142,7 @@ class LiuZhaoBrogliato(Law):
             kind="str",
             choices=("bi", "mono"),
         ),
-        Spec("rtol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),
+        Spec("tol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),
         Spec(
             "method", "DOP853", "solve_ivp method", kind="str", choices=("DOP853", "RK45", "Radau")
         ),
@@ -159,9 +159,9 @@ class LiuZhaoBrogliato(Law):
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
-        diagnostics: dict[str, Any] = {"variant": options["variant"], "rtol": options["rtol"]}
+        diagnostics: dict[str, Any] = {"variant": options["variant"], "tol": options["tol"]}
         speed = np.abs(np.concatenate([problem.un, problem.ut])).max()
-        if not (problem.un < -REST_FACTOR * options["rtol"] * speed).any():
+        if not (problem.un < -REST_FACTOR * options["tol"] * speed).any():
             diagnostics.update(formulation="no approaching contact", **_nothing(problem.m))
             return Outcome.from_impulses(problem, np.zeros(problem.m), diagnostics=diagnostics)
         if not problem.frictional and is_diagonal(problem.delassus) and not options["path"]:
@@ -170,7 +170,7 @@ class LiuZhaoBrogliato(Law):
         impact = EnergeticImpact(
             problem,
             options["variant"],
-            options["rtol"],
+            options["tol"],
             options["method"],
             options["max_steps"],
             options["max_events"],
