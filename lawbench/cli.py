@@ -19,6 +19,7 @@ from lawbench.case import CASES, Case
 from lawbench.checks import run_checks
 from lawbench.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
 from lawbench.law import LAWS, Law
+from lawbench.problem import ImpactProblem
 from lawbench.serialize import trial_record
 
 
@@ -96,10 +97,31 @@ def _describe(args: argparse.Namespace) -> None:
         raise InvalidProblem(f"unknown law or case {args.name!r}; known: {known}")
 
 
-def _solve(args: argparse.Namespace) -> None:
+def _scene_or_problem(args: argparse.Namespace) -> tuple[str | ImpactProblem, dict[str, str]]:
+    """The scene name and its parameters, or the problem of ``--problem FILE``."""
     params = _assignments(args.set, "--set")
+    if (args.case is None) == (args.problem is None):
+        raise InvalidProblem("give a scene name or --problem FILE (one of the two)")
+    if args.problem is None:
+        return args.case, params
+    if params:
+        raise InvalidProblem("--set gives scene parameters; a problem file is solved as it is")
+    from lawbench.problem_files import load_problem
+
+    return load_problem(args.problem), {}
+
+
+def _export(args: argparse.Namespace) -> None:
+    from lawbench.problem_files import save_problem
+
+    path = save_problem(CASES.get(args.case).build(**_assignments(args.set, "--set")), args.out)
+    print(f"problem written to {path}")
+
+
+def _solve(args: argparse.Namespace) -> None:
+    case, params = _scene_or_problem(args)
     options = _assignments(args.option, "--option")
-    trial = evaluate(args.law, args.case, options, **params)
+    trial = evaluate(args.law, case, options, **params)
     record = trial_record(trial, run_checks(trial))
     if args.json:
         print(json.dumps(record, indent=2, allow_nan=False))
@@ -226,9 +248,12 @@ def build_parser() -> argparse.ArgumentParser:
     describe = commands.add_parser("describe", help="describe a law or a case")
     describe.add_argument("name", help="a law or case name")
     describe.set_defaults(run=_describe)
-    solve = commands.add_parser("solve", help="solve one case with one law")
+    solve = commands.add_parser("solve", help="solve one case (or a problem file) with one law")
     solve.add_argument("law")
-    solve.add_argument("case")
+    solve.add_argument("case", nargs="?", help="a scene name (or give --problem FILE)")
+    solve.add_argument(
+        "--problem", metavar="FILE", help="a problem file (.json, .npz, .h5): see lawbench export"
+    )
     solve.add_argument(
         "--set",
         action="append",
@@ -241,6 +266,15 @@ def build_parser() -> argparse.ArgumentParser:
     )
     solve.add_argument("--json", action="store_true", help="print one JSON object")
     solve.set_defaults(run=_solve)
+    export = commands.add_parser("export", help="write a scene's problem to a file")
+    export.add_argument("case")
+    export.add_argument(
+        "--set", action="append", default=[], metavar="NAME=VALUE", help="a case parameter"
+    )
+    export.add_argument(
+        "-o", "--out", required=True, metavar="FILE", help="the file: .json, .npz, .h5 or .hdf5"
+    )
+    export.set_defaults(run=_export)
     report = commands.add_parser("report", help="write the comparison report")
     report.add_argument("--out", default="reports/latest", help="output folder")
     size = report.add_mutually_exclusive_group()

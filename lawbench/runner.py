@@ -230,8 +230,11 @@ def _processes(
 def _dask(
     chunks: list, checks: Sequence[str], settings: dict, address: Any, workers: Any
 ) -> Results:
-    from dask.distributed import Client, LocalCluster
-    from dask.distributed import as_completed as dask_completed
+    try:
+        from dask.distributed import Client, LocalCluster
+        from dask.distributed import as_completed as dask_completed
+    except ImportError:  # an optional dependency: say how to get it
+        raise InvalidProblem("the dask executor needs Dask: pip install 'lawbench[dask]'") from None
 
     cluster = None
     try:

@@ -1,0 +1,119 @@
+"""Problems in files: every scene round-trips through JSON, NPZ and HDF5, bit for bit."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import lawbench
+from lawbench.problem_files import load_problem, save_problem
+
+ENCODINGS = (".json", ".npz", ".h5")
+# The integrating laws cost seconds a solve: their round trip is checked on the defaults.
+SLOW = {"compliant", "lzb", "jia", "darboux_keller"}
+
+
+def examples():
+    for case in lawbench.CASES:
+        for example in case.examples:
+            yield pytest.param(case.name, example, id=f"{case.name}-{example}".replace(" ", "_"))
+
+
+def same_problem(a, b):
+    for name in ("M", "Wn", "v", "gaps"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert (a.Wt is None) == (b.Wt is None)
+    if a.Wt is not None:
+        assert np.array_equal(a.Wt, b.Wt)
+    assert a.contacts == b.contacts
+    assert a.bodies == b.bodies
+
+
+@pytest.mark.parametrize(("case", "example"), list(examples()))
+def test_every_scene_round_trips_to_an_identical_problem_and_outcomes(case, example, tmp_path):
+    scene = lawbench.CASES.get(case)
+    problem = scene.build(**scene.examples[example])
+    for suffix in ENCODINGS:
+        loaded = load_problem(save_problem(problem, tmp_path / f"p{suffix}"))
+        same_problem(problem, loaded)
+        for law in lawbench.LAWS:
+            if law.name in SLOW and example != next(iter(scene.examples)):
+                continue
+            try:
+                expected = law.resolve(problem)
+            except lawbench.LawbenchError as exc:
+                with pytest.raises(type(exc)):
+                    law.resolve(loaded)
+                continue
+            obtained = law.resolve(loaded)
+            for field in ("v_plus", "Pn", "Pt"):
+                assert np.array_equal(getattr(expected, field), getattr(obtained, field)), (
+                    law.name,
+                    suffix,
+                    field,
+                )
+
+
+def test_a_sparse_chain_is_stored_sparse(tmp_path):
+    problem = lawbench.CASES.get("ball_chain").build(n=200)
+    dense = tmp_path / "dense.json"
+    sparse = save_problem(problem, tmp_path / "chain.npz")
+    save_problem(problem, dense)
+    with np.load(sparse) as archive:
+        assert "M.data" in archive.files and "Wn.indptr" in archive.files
+    assert sparse.stat().st_size < dense.stat().st_size / 20
+    same_problem(problem, load_problem(sparse))
+
+
+def run(*argv, cwd):
+    return subprocess.run(
+        [sys.executable, "-m", "lawbench", *argv], capture_output=True, text=True, cwd=cwd
+    )
+
+
+def test_export_then_solve_the_file_from_the_command_line(tmp_path):
+    exported = run("export", "three_ball_chain", "--set", "e=0.5", "-o", "p.json", cwd=tmp_path)
+    assert exported.returncode == 0, exported.stderr
+    from_file = run("solve", "moreau", "--problem", "p.json", "--json", cwd=tmp_path)
+    from_scene = run(
+        "solve", "moreau", "three_ball_chain", "--set", "e=0.5", "--json", cwd=tmp_path
+    )
+    assert from_file.returncode == 0, from_file.stderr
+    assert json.loads(from_file.stdout)["v_plus"] == json.loads(from_scene.stdout)["v_plus"]
+    assert json.loads(from_file.stdout)["case"] == "problem"
+
+
+GOOD = {
+    "format": "lawbench-problem",
+    "version": 1,
+    "M": [[1.0]],
+    "Wn": [[1.0]],
+    "v": [-1.0],
+    "contacts": [{"e": 0.5}],
+}
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "message"),
+    [
+        ("p.json", {**GOOD, "version": 2}, "version 2 is not supported"),
+        ("p.json", {**GOOD, "format": "other"}, "format is 'other'"),
+        ("p.json", {k: v for k, v in GOOD.items() if k != "Wn"}, "field 'Wn' is missing"),
+        ("p.json", {**GOOD, "Wn": [[1.0, 2.0]]}, r"Wn has shape \(1, 2\), expected \(1, 1\)"),
+        ("p.json", {**GOOD, "contacts": [{"e": "half"}]}, r"contacts\[0\]\.e = 'half'"),
+        ("p.json", {**GOOD, "contacts": [{"e": 1.5}]}, r"contacts\[0\]\.e = 1\.5"),
+        ("p.json", "{not json", "malformed JSON"),
+        ("p.npz", "garbage bytes", "not a lawbench problem file"),
+        ("p.txt", GOOD, "unknown extension '.txt'"),
+    ],
+)
+def test_bad_files_exit_2_with_one_line_naming_the_field(tmp_path, name, content, message):
+    path = tmp_path / name
+    path.write_text(content if isinstance(content, str) else json.dumps(content))
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        load_problem(path)
+    done = run("solve", "newton", "--problem", name, cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
