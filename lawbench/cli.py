@@ -112,9 +112,14 @@ def _scene_or_problem(args: argparse.Namespace) -> tuple[str | ImpactProblem, di
 
 
 def _export(args: argparse.Namespace) -> None:
+    from lawbench.fclib import write_fclib
     from lawbench.problem_files import save_problem
 
-    path = save_problem(CASES.get(args.case).build(**_assignments(args.set, "--set")), args.out)
+    problem = CASES.get(args.case).build(**_assignments(args.set, "--set"))
+    if args.fclib:
+        path = write_fclib(problem, args.out, args.fclib)
+    else:
+        path = save_problem(problem, args.out)
     print(f"problem written to {path}")
 
 
@@ -273,6 +278,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     export.add_argument(
         "-o", "--out", required=True, metavar="FILE", help="the file: .json, .npz, .h5 or .hdf5"
+    )
+    export.add_argument(
+        "--fclib",
+        choices=("local", "global"),
+        help="write an FCLIB problem (HDF5) in its local or global form instead",
     )
     export.set_defaults(run=_export)
     report = commands.add_parser("report", help="write the comparison report")

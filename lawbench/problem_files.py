@@ -124,6 +124,8 @@ def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
 def load_problem(path: str | Path) -> ImpactProblem:
     """Read a problem written by `save_problem` (or by hand, in the same format).
 
+    An HDF5 file holding an FCLIB problem is read as one (`lawbench.fclib.read_fclib`).
+
     Raises
     ------
     InvalidProblem
@@ -132,6 +134,11 @@ def load_problem(path: str | Path) -> ImpactProblem:
     """
     path = Path(path)
     reader = _codec(path)[1]
+    if reader is _read_hdf5:
+        from lawbench.fclib import is_fclib, read_fclib
+
+        if is_fclib(path):
+            return read_fclib(path)
     try:
         data = reader(path)
     except InvalidProblem:

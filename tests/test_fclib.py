@@ -1,0 +1,126 @@
+"""FCLIB files: read as impacts with e = 0, solved exactly by Moreau's law with Coulomb cones.
+
+The reader is checked against files written here with h5py in FCLIB's own layout
+(``fclib.h``/``fclib.c`` of the FCLIB library: ``/fclib_local/W`` as a sparse matrix with
+``nzmax, m, n, nz, p, i, x``; ``/fclib_local/vectors/q`` and ``mu``; ``spacedim``), so that it
+is not only held to our own writer.
+"""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import lawbench
+from lawbench.fclib import read_fclib, write_fclib
+
+h5py = pytest.importorskip("h5py")
+
+
+def fclib_local(path, W, q, mu, layout):
+    """Write a local FCLIB problem with W in the given sparse layout (triplet, csc, csr)."""
+    with h5py.File(path, "w") as handle:
+        root = handle.create_group("fclib_local")
+        root.create_dataset("spacedim", data=np.array([3], dtype=np.int32))
+        group = root.create_group("W")
+        m, n = W.shape
+        rows, cols = np.nonzero(W)
+        if layout == "triplet":
+            p, i, x, nz = rows, cols, W[rows, cols], len(rows)
+        else:
+            import scipy.sparse
+
+            sparse = (scipy.sparse.csc_matrix if layout == "csc" else scipy.sparse.csr_matrix)(W)
+            p, i, x, nz = sparse.indptr, sparse.indices, sparse.data, -1 if layout == "csc" else -2
+        for key, value in (("nzmax", len(x)), ("m", m), ("n", n), ("nz", nz)):
+            group.create_dataset(key, data=np.array([value], dtype=np.int32))
+        group.create_dataset("p", data=np.asarray(p, dtype=np.int32))
+        group.create_dataset("i", data=np.asarray(i, dtype=np.int32))
+        group.create_dataset("x", data=np.asarray(x, dtype=float))
+        vectors = root.create_group("vectors")
+        vectors.create_dataset("q", data=q)
+        vectors.create_dataset("mu", data=mu)
+
+
+def random_local(rng, contacts):
+    A = rng.normal(size=(3 * contacts, 3 * contacts))
+    W = A @ A.T + 0.1 * np.eye(3 * contacts)
+    q = rng.normal(size=3 * contacts)
+    q[0::3] = -np.abs(q[0::3]) - 0.5  # every contact approaches
+    return W, q, rng.uniform(0.1, 1.0, contacts)
+
+
+def local_velocity_and_impulse(problem, outcome):
+    """u = W.T v+ and r = (Pn, Pt) in FCLIB's per-contact order (n, t1, t2)."""
+    m = problem.m
+    u_n, u_t = problem.Wn.T @ outcome.v_plus, problem.Wt.T @ outcome.v_plus
+    u = np.column_stack([u_n, u_t.reshape(m, 2)]).ravel()
+    r = np.column_stack([outcome.Pn, outcome.Pt.reshape(m, 2)]).ravel()
+    return u, r
+
+
+@pytest.mark.parametrize("layout", ["triplet", "csc", "csr"])
+@pytest.mark.parametrize("contacts", [1, 3])
+def test_moreau_solves_the_fclib_local_problem(tmp_path, layout, contacts):
+    """u = W r + q, r in the cones, De Saxce's complementarity (Acary et al., FCLIB, 2014)."""
+    W, q, mu = random_local(np.random.default_rng(contacts), contacts)
+    path = tmp_path / "local.hdf5"
+    fclib_local(path, W, q, mu, layout)
+    problem = read_fclib(path)
+    assert [c.e for c in problem.contacts] == [0.0] * contacts
+    outcome = lawbench.solve("moreau", problem)
+    u, r = local_velocity_and_impulse(problem, outcome)
+    scale = np.abs(q).max()
+    assert np.abs(u - (W @ r + q)).max() <= 1e-9 * scale
+    for j in range(contacts):
+        un, ut, rn, rt = u[3 * j], u[3 * j + 1 : 3 * j + 3], r[3 * j], r[3 * j + 1 : 3 * j + 3]
+        assert np.linalg.norm(rt) <= mu[j] * rn + 1e-9 * np.abs(r).max()
+        modified = un + mu[j] * np.linalg.norm(ut)
+        assert mu[j] * np.linalg.norm(ut) <= modified + 1e-8 * scale  # in the dual cone
+        assert abs(modified * rn + ut @ rt) <= 1e-8 * scale * np.abs(r).max()
+
+
+@pytest.mark.parametrize("case", ["rocking_block", "sphere_wall", "bouncing_ball"])
+def test_local_and_global_round_trips(tmp_path, case):
+    problem = lawbench.CASES.get(case).build()
+    local = read_fclib(write_fclib(problem, tmp_path / "local.h5", "local"))
+    assert np.allclose(local.W.T @ local.v, problem.W.T @ problem.v, rtol=1e-12, atol=1e-14)
+    assert np.allclose(local.contact_delassus, problem.contact_delassus, rtol=1e-10, atol=1e-12)
+    global_ = read_fclib(write_fclib(problem, tmp_path / "global.h5", "global"))
+    assert np.array_equal(global_.M, problem.M) and np.array_equal(global_.W, problem.W)
+    assert np.allclose(global_.v, problem.v, rtol=1e-13, atol=1e-15)
+    assert np.allclose(
+        lawbench.solve("moreau", global_).v_plus,
+        lawbench.solve(
+            "moreau",
+            problem.__class__.from_arrays(
+                problem.M, problem.Wn, problem.v, problem.Wt, e=0.0, mu=problem.mu
+            ),
+        ).v_plus,
+        atol=1e-10,
+    )
+
+
+def test_solve_an_fclib_file_from_the_command_line(tmp_path):
+    W, q, mu = random_local(np.random.default_rng(5), 2)
+    fclib_local(tmp_path / "p.hdf5", W, q, mu, "csc")
+    done = subprocess.run(
+        [sys.executable, "-m", "lawbench", "solve", "moreau", "--problem", "p.hdf5", "--json"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, done.stderr
+    assert len(json.loads(done.stdout)["Pn"]) == 2
+
+
+def test_a_file_that_is_not_an_impact_problem_is_refused_by_name(tmp_path):
+    W, q, mu = random_local(np.random.default_rng(6), 1)
+    path = tmp_path / "bad.hdf5"
+    fclib_local(path, W, q, mu, "csc")
+    with h5py.File(path, "a") as handle:
+        del handle["fclib_local/vectors/q"]
+    with pytest.raises(lawbench.InvalidProblem, match="vectors/q is missing"):
+        read_fclib(path)
