@@ -72,6 +72,10 @@ def _difference(base: np.ndarray | None, new: np.ndarray | None) -> float:
     return float(np.abs(new - base).max() / max(1.0, np.abs(base).max()))
 
 
+# What a row computed now but absent from the baselines says in the drift table.
+NEW_ROW = "new row"
+
+
 def compare(
     obtained: pd.DataFrame, expected: pd.DataFrame, tolerances: dict[str, dict[str, float]]
 ) -> pd.DataFrame:
@@ -83,7 +87,7 @@ def compare(
     for record in merged.to_dict("records"):
         where = {k: record[k] for k in IDENTITY}
         if record["_merge"] != "both":
-            side = "only in the baseline" if record["_merge"] == "left_only" else "new row"
+            side = "only in the baseline" if record["_merge"] == "left_only" else NEW_ROW
             drift.append({**where, "quantity": "row", "baseline": side, "obtained": ""})
             continue
         quantities = ["error_class", *QUANTITIES]

@@ -1,7 +1,8 @@
 """The ``lawbench`` command line.
 
 Exit codes: 0 done; 2 bad usage or invalid input; 3 the law does not apply; 4 solver failure;
-5 a regression drifted past its baseline; 1 an unexpected internal error. Errors are one line
+5 a regression drifted past its baseline; 6 a law fails the common checks (``lawbench check``);
+1 an unexpected internal error. Errors are one line
 on stderr, never a traceback.
 """
 
@@ -27,7 +28,17 @@ class Drift(LawbenchError):
     """Outcomes moved past their baseline tolerance."""
 
 
-EXIT_CODES = {InvalidProblem: 2, NotApplicable: 3, SolverFailure: 4, LawbenchError: 5}
+class CheckFailed(LawbenchError):
+    """A law fails the common checks (a numerical failure or an unexplained verdict)."""
+
+
+EXIT_CODES = {
+    InvalidProblem: 2,
+    NotApplicable: 3,
+    SolverFailure: 4,
+    CheckFailed: 6,
+    LawbenchError: 5,
+}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -51,12 +62,56 @@ def _assignments(items: Sequence[str], flag: str) -> dict[str, str]:
 
 
 def _list(args: argparse.Namespace) -> None:
-    print("laws:")
-    for law in LAWS:
-        print(f"  {law.name:<16} {law.summary}")
-    print("cases:")
-    for case in CASES:
-        print(f"  {case.name:<16} {case.summary}")
+    for registry in (LAWS, CASES):
+        print(f"{registry.kind}s:")
+        for entry in registry:
+            print(f"  {entry.name:<16} {entry.summary}")
+        if registry.unavailable:
+            print(f"{registry.kind}s not loaded:")
+            for name, reason in registry.unavailable.items():
+                print(f"  {name:<16} {reason}")
+
+
+def _law_object(text: str) -> Law:
+    """A registered law's name, or ``module:attribute`` naming a law (class or instance)."""
+    if ":" not in text:
+        return LAWS.get(text)
+    import importlib
+
+    module, _, attribute = text.partition(":")
+    try:
+        loaded = getattr(importlib.import_module(module), attribute)
+    except (ImportError, AttributeError) as exc:
+        raise InvalidProblem(f"{text}: cannot be imported ({exc})") from None
+    law = loaded() if isinstance(loaded, type) else loaded
+    if not isinstance(law, Law):
+        raise InvalidProblem(f"{text} is not a lawbench.Law")
+    return law
+
+
+def _check(args: argparse.Namespace) -> None:
+    from lawbench.testing import check_law
+
+    cases = args.cases.split(",") if args.cases else None
+    report = check_law(_law_object(args.law), cases=cases, random_problems=args.random)
+    frame = report.to_frame()
+    if args.json:
+        print(frame.to_json(orient="records", indent=1))
+    else:
+        with_values = frame.assign(value=frame["value"].map(_short))
+        print(with_values.drop(columns=["law", "claim"]).to_string(index=False, max_colwidth=70))
+        print(", ".join(f"{n} {v}" for v, n in report.counts().items()))
+    for problem in report.declaration:
+        print(f"declaration: {problem}", file=sys.stderr)
+    if not report.passed:
+        names = sorted({f"{r['check']} on {r['scene']}" for r in report.failures})
+        raise CheckFailed(
+            f"{report.law} fails the common checks: {', '.join(names) or 'declaration'}"
+        )
+
+
+def _short(value: object) -> str:
+    return "" if value is None or value != value else f"{value:.3g}"
 
 
 def _describe_law(law: Law) -> None:
@@ -71,6 +126,11 @@ def _describe_law(law: Law) -> None:
     print("options:" if law.options else "options: none")
     for spec in law.options:
         print(f"  {spec.name} = {spec.default!r}  ({spec.describe_range()}) {spec.doc}")
+    for title, claims in (("findings", law.findings), ("guarantees", law.guarantees)):
+        print(f"{title}:" if claims else f"{title}: none")
+        for claim in claims:
+            print(f"  {claim.check}: {claim.reason}")
+            print(f"    where: {claim.region.text}; source: {claim.source}")
 
 
 def _describe_case(case: Case) -> None:
@@ -228,7 +288,7 @@ def _bench(args: argparse.Namespace) -> None:
 
 
 def _regress(args: argparse.Namespace) -> None:
-    from lawbench.baselines import regress
+    from lawbench.baselines import NEW_ROW, regress
 
     laws = args.laws.split(",") if args.laws else None
     cases = args.cases.split(",") if args.cases else None
@@ -238,6 +298,12 @@ def _regress(args: argparse.Namespace) -> None:
         if len(drift):
             print(drift.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
         return
+    new = drift["baseline"] == NEW_ROW if len(drift) else []
+    if len(drift) and new.any():
+        # A law or scene added since the baselines were written has no baseline yet: not drift.
+        pairs = sorted({f"{r.law} on {r.case}" for r in drift[new].itertuples()})
+        print(f"no baseline yet for {', '.join(pairs)} (lawbench regress --update writes it)")
+        drift = drift[~new]
     if len(drift):
         print(drift.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
         raise Drift(f"regress: {len(drift)} quantities drifted past their tolerance")
@@ -333,6 +399,14 @@ def build_parser() -> argparse.ArgumentParser:
     regress.add_argument("--laws", help="comma-separated laws")
     regress.add_argument("--cases", help="comma-separated cases")
     regress.set_defaults(run=_regress)
+    check = commands.add_parser(
+        "check", help="hold a law to the common checks (exit 6 when a cell is not acceptable)"
+    )
+    check.add_argument("law", help="a law name, or module:attribute of a law not registered")
+    check.add_argument("--cases", help="comma-separated scenes (default: every one it treats)")
+    check.add_argument("--random", type=int, default=3, help="seeded random problems (3)")
+    check.add_argument("--json", action="store_true", help="print the table as JSON records")
+    check.set_defaults(run=_check)
     bench = commands.add_parser(
         "bench", help="time the laws against clarabel and numpy called directly (ratios)"
     )

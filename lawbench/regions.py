@@ -30,6 +30,7 @@ __all__ = [
     "example",
     "frictional",
     "frictionless",
+    "nonlinear_springs",
     "oblique_contacts",
     "option",
     "separating_contact",
@@ -106,3 +107,13 @@ def example(case: str, name: str) -> Region:
         return trial.params == trial.case.parameters(**trial.case.examples[name])
 
     return Region(f"{case}, example '{name}'", contains)
+
+
+def _nonlinear(trial: Any) -> bool:
+    problem = trial.problem
+    return int(problem.closed.sum()) > 1 and any(c.exponent != 1 for c in problem.contacts)
+
+
+nonlinear_springs = Region(
+    "several contacts, some with a force law other than linear (exponent != 1)", _nonlinear
+)

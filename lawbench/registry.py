@@ -1,14 +1,20 @@
-"""Registries of laws and cases, filled by the modules of a package on first use.
+"""Registries of laws and cases, filled by the modules of a package and by plugins on first use.
 
-Each module of ``lawbench.laws`` (``lawbench.cases``) registers its entry when imported. The
-modules are imported the first time a registry is asked for a name, so importing lawbench stays
-cheap; a module whose optional dependency is missing is skipped and its reason kept in
-`Registry.unavailable` instead of breaking the others.
+Each module of ``lawbench.laws`` (``lawbench.cases``) registers its entry when imported. Other
+distributions add entries through entry points of the group of the same name
+(``[project.entry-points."lawbench.laws"]``): an entry point names a module (importing it
+registers its entries, like the built-in ones) or a `Law`/`Case` subclass or instance (the
+registry registers it). Everything is imported the first time a registry is asked for a name,
+so importing lawbench stays cheap. A module or plugin that fails to import, raises, or
+registers a name twice is skipped and its reason kept in `Registry.unavailable` instead of
+breaking the others.
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
+import inspect
 import pkgutil
 from collections.abc import Iterator
 from typing import Generic, Protocol, TypeVar
@@ -60,6 +66,23 @@ class Registry(Generic[Entry]):
                 importlib.import_module(f"{self.package}.{module.name}")
             except ImportError as exc:
                 self.unavailable[module.name] = f"missing dependency: {exc}"
+        for point in importlib.metadata.entry_points(group=self.package):
+            try:
+                self._plug(point.load())
+            except Exception as exc:  # a broken plugin is reported, the others still load
+                self.unavailable[point.name] = f"plugin {point.value}: {type(exc).__name__}: {exc}"
+
+    def _plug(self, loaded: object) -> None:
+        """Register what an entry point names: a module registered itself on import."""
+        if inspect.ismodule(loaded):
+            return
+        kind = loaded if inspect.isclass(loaded) else type(loaded)
+        name = getattr(loaded, "name", None)
+        if not isinstance(name, str):
+            raise TypeError(f"{loaded!r} is neither a module nor a {self.kind} with a name")
+        if isinstance(self._entries.get(name), kind):
+            return  # its module registered it when the entry point imported it
+        self.register(loaded() if inspect.isclass(loaded) else loaded)
 
     def get(self, name: str | Entry) -> Entry:
         """Return the entry called ``name`` (an entry is returned as it is).

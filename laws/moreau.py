@@ -82,6 +82,7 @@ import numpy as np
 
 from lawbench import cones
 from lawbench.batch import ProblemBatch
+from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
 from lawbench.errors import BudgetExceeded
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
@@ -158,6 +159,8 @@ class Moreau(Law):
     )
 
     findings = (
+        PAOLI_DISCONTINUITY,
+        RIGID_DISPERSION,
         Claim(
             "energy_gain",
             separating_contact & option("separating", "unilateral"),

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.batch import ProblemBatch
+from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
 from lawbench.errors import NotApplicable
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
@@ -45,6 +46,8 @@ class Newton(Law):
     tags = Tags(several_contacts=True)
 
     findings = (
+        PAOLI_DISCONTINUITY,
+        RIGID_DISPERSION,
         Claim(
             "admissible",
             separating_contact,

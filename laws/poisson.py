@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.batch import ProblemBatch
+from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
@@ -39,6 +40,10 @@ class Poisson(Law):
     summary = "Poisson's kinetic restitution: compression then expansion complementarity problems"
     source = "Pfeiffer and Glocker 1996, ch. 7; Brogliato 2010, kinetic coefficient"
     tags = Tags(several_contacts=True)
+    findings = (
+        PAOLI_DISCONTINUITY,
+        RIGID_DISPERSION,
+    )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         G, e = problem.delassus, problem.restitution("poisson")

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.claims import RIGID_DISPERSION
 from lawbench.errors import BudgetExceeded
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
@@ -45,6 +46,7 @@ class Sequential(Law):
     summary = "pairwise binary Newton impacts in a chosen order until no contact approaches"
     source = "Brogliato 2010, eqs. (27)-(28): sequences of binary impacts"
     tags = Tags(several_contacts=True, accuracy_knob="order")
+    findings = (RIGID_DISPERSION,)
     options = (
         Spec(
             "order",

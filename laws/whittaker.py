@@ -77,6 +77,7 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
+from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.law import LAWS, Law
 from lawbench.lemke import RayTermination, lemke
@@ -397,6 +398,8 @@ class Whittaker(Law):
     tags = Tags(friction=True, several_contacts=True, spatial=True)
 
     findings = (
+        PAOLI_DISCONTINUITY,
+        RIGID_DISPERSION,
         Claim(
             "energy_gain",
             separating_contact,

@@ -1,13 +1,13 @@
-"""Every registered law on every case it applies to, every example, every single-solve check.
+"""Every registered law held to the common checks, one test per cell of `check_law`.
 
-(``continuity`` and ``dispersion`` solve the case again; their own tests cover them.)
-
-The pattern of scikit-learn's common estimator checks: the scene's tags and the law's decide
-what runs; a check that does not apply is skipped with its reason. Every cell must end in a
-verdict a table may ship: *holds*, *refused*, or *law property* (a failure the law's findings
-predict, run as an expected failure with the finding's reason). A *numerical failure* or an
-*unexplained* verdict fails the test. Each finding is also held to its witnesses, so a finding
-that stops holding is noticed.
+The pattern of scikit-learn's common estimator checks, on `lawbench.testing` (the same cells
+`lawbench check LAW` prints): every check the law's tags make applicable, on every scene it
+can treat (each named example; continuity and dispersion on the defaults) and on seeded random
+chains. Every cell must end in a verdict a table may ship: *holds*, *refused* or *budget*
+(skipped with the reason), or *law property* (a failure the law's findings predict, run as an
+expected failure with the finding). A *numerical failure* or an *unexplained* verdict fails
+the test. Each finding is also held to its witnesses, so a finding that stops holding is
+noticed.
 """
 
 from functools import cache
@@ -15,7 +15,7 @@ from functools import cache
 import pytest
 
 import lawbench
-from lawbench.checks import SINGLE_SOLVE
+from lawbench.testing import cells, run_cell
 from lawbench.verdicts import Verdict
 
 
@@ -29,33 +29,17 @@ def trial(law_name, case_name, example):
         return str(refusal)
 
 
-def combinations():
-    for law in lawbench.LAWS:
-        for case in lawbench.CASES:
-            if not law.tags.covers(case.requires):
-                continue
-            for example in case.examples:
-                for check in SINGLE_SOLVE:
-                    yield pytest.param(
-                        law.name,
-                        case.name,
-                        example,
-                        check,
-                        id=f"{law.name}-{case.name}-{example}-{check}".replace(" ", "_"),
-                    )
+ALL_CELLS = [(law, cell) for law in lawbench.LAWS for cell in cells(law)]
 
 
-@pytest.mark.parametrize(("law", "case", "example", "check"), list(combinations()))
-def test_common_check(law, case, example, check):
-    solved = trial(law, case, example)
-    if isinstance(solved, str):
-        pytest.skip(f"the law does not apply: {solved}")
-    result = lawbench.CHECKS[check](solved)
-    if result.verdict == Verdict.REFUSED:
-        pytest.skip(result.detail)
-    if result.verdict == Verdict.LAW_PROPERTY:
-        pytest.xfail(result.claim.describe())
-    assert result.verdict == Verdict.HOLDS, f"{result.verdict}: {result.detail}"
+@pytest.mark.parametrize(("law", "cell"), ALL_CELLS, ids=[cell.id for _, cell in ALL_CELLS])
+def test_common_check(law, cell):
+    row = run_cell(law, cell)
+    if row["verdict"] in (Verdict.REFUSED, Verdict.BUDGET):
+        pytest.skip(f"{row['verdict']}: {row['detail']}")
+    if row["verdict"] == Verdict.LAW_PROPERTY:
+        pytest.xfail(row["claim"])
+    assert row["verdict"] == Verdict.HOLDS, f"{row['verdict']}: {row['detail']}"
 
 
 def witnesses():

@@ -2,13 +2,15 @@
 
 The case is solved again under vanishing perturbations: small initial gaps that let one contact
 close first (each contact in turn), and small velocity perturbations at zero gaps, at each size
-of ``settings['continuity_sizes']`` (default 1e-2, 1e-4, 1e-6; gaps in metres, velocity changes
-relative to the largest velocity). A rigid law meets the gaps event by event
-(`lawbench.events.resolve_with_gaps`). The value is the outcome jump that remains at the
-smallest size, relative to the largest velocity; continuous when it is below 1e-3. The detail
-gives the jumps per size and the kinetic angles between the contacts, which by Paoli's
-condition (Brogliato 2010, 'kinetic angle and continuity') predict where rigid laws must be
-discontinuous: angles other than 90 degrees with e > 0.
+of ``settings['continuity_sizes']`` (default 1e-2, 1e-4, 1e-6), relative to the problem's own
+scales: gaps relative to the largest contact indentation of the impact (`indentation_scale`, so
+that a gap vanishes against the deformation a compliant contact resolves, steel beads indenting
+by micrometres included), velocity changes relative to the largest velocity. A rigid law meets
+the gaps event by event (`lawbench.events.resolve_with_gaps`). The value is the outcome jump
+that remains at the smallest size, relative to the largest velocity; continuous when it is
+below 1e-3. The detail gives the jumps per size and the kinetic angles between the contacts,
+which by Paoli's condition (Brogliato 2010, 'kinetic angle and continuity') predict where rigid
+laws must be discontinuous: angles other than 90 degrees with e > 0.
 """
 
 from __future__ import annotations
@@ -21,9 +23,26 @@ from lawbench.checks.base import Trial, check
 from lawbench.errors import LawbenchError
 from lawbench.events import resolve_with_gaps
 from lawbench.mechanics import kinetic_angles
+from lawbench.problem import ImpactProblem
 
 SIZES = (1e-2, 1e-4, 1e-6)
 CONTINUOUS = 1e-3
+
+
+def indentation_scale(problem: ImpactProblem) -> float:
+    """Largest indentation of a contact that stops its approach alone (metres).
+
+    For contact j with effective mass ``1 / G_jj``, approach speed ``|un|`` (the largest of
+    the problem), stiffness ``k`` and exponent ``eta``: the kinetic energy
+    ``|un|^2 / (2 G_jj)`` equals the stored ``k delta^(eta + 1) / (eta + 1)``.
+    """
+    speed = float(np.abs(problem.un).max()) or float(np.abs(problem.v).max())
+    scales = [
+        ((c.exponent + 1) * speed**2 / (2 * problem.delassus[j, j] * c.stiffness))
+        ** (1 / (c.exponent + 1))
+        for j, c in enumerate(problem.contacts)
+    ]
+    return max(scales)
 
 
 def jumps(trial: Trial, sizes: tuple[float, ...] = SIZES) -> dict[str, list[float]]:
@@ -31,13 +50,14 @@ def jumps(trial: Trial, sizes: tuple[float, ...] = SIZES) -> dict[str, list[floa
     problem, law, options = trial.problem, trial.law, trial.options
     base = trial.outcome.v_plus
     scale = float(np.abs(problem.v).max())
+    length = indentation_scale(problem)
     directions = np.random.default_rng(0).normal(size=(3, problem.n))
     directions /= np.abs(directions).max(axis=1, keepdims=True)
     result: dict[str, list[float]] = {"gaps": [], "velocities": []}
     for size in sizes:
         gap_jump = 0.0
         for first in range(problem.m):
-            gaps = np.full(problem.m, size)
+            gaps = np.full(problem.m, size * length)
             gaps[first] = 0.0
             moved = resolve_with_gaps(law, dataclasses.replace(problem, gaps=gaps), options)
             gap_jump = max(gap_jump, float(np.abs(moved.v_plus - base).max()) / scale)

@@ -59,13 +59,17 @@ from typing import Any
 import numpy as np
 from lawbench.laws.jia.dynamics import SpringImpact, Springs
 
+from lawbench.claims import PAOLI_DISCONTINUITY
 from lawbench.errors import NotApplicable
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.regions import nonlinear_springs
+from lawbench.solvers import solve_lcp
 from lawbench.spec import Spec
 from lawbench.tags import Tags
+from lawbench.verdicts import Claim
 
 POISSON_RATIO = 0.3
 DEFAULT_TANGENTIAL_STIFFNESS_RATIO = (2 - POISSON_RATIO) / (2 * (1 - POISSON_RATIO))
@@ -90,6 +94,18 @@ class Jia(Law):
         spatial=True,
         stiffness=True,
         accuracy_knob="tol",
+    )
+    findings = (
+        PAOLI_DISCONTINUITY,
+        Claim(
+            "dispersion",
+            nonlinear_springs,
+            "Jia, Mason and Erdmann, IJRR 32(1) 2013: every contact a linear normal spring",
+            "the law's springs are linear and the contacts' exponent is not read, so with Hertz "
+            "contacts the energy spreads over the bodies as it would with linear ones, unlike the "
+            "compliant ground truth",
+            (("ball_chain", "default"),),
+        ),
     )
     options = (
         Spec(
@@ -163,7 +179,17 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
         diagnostics["springs"] = "linear: the contacts' exponent is not read"
     path = _path(impact, eta0_sq) if options["path"] else None
     Pt = state[2 * m : 2 * m + d] if d else None
-    return Outcome.from_impulses(problem, state[:m], Pt, diagnostics=diagnostics, path=path)
+    Pn = state[:m]
+    if not d:
+        # A contact left approaching slower than the reactivation threshold (100 tol times the
+        # largest speed) would be reactivated with negligible energy and stopped: its limit,
+        # a plastic stop, keeps the outcome admissible at the cost of an O(tol) impulse.
+        after = problem.un + problem.delassus @ Pn
+        if (after < 0).any():
+            stop = solve_lcp(problem.delassus, after).z
+            Pn = Pn + stop
+            diagnostics["plastic_stop"] = float(stop.max())
+    return Outcome.from_impulses(problem, Pn, Pt, diagnostics=diagnostics, path=path)
 
 
 def _path(impact: SpringImpact, eta0_sq: float) -> dict[str, np.ndarray]:

@@ -116,6 +116,7 @@ import scipy.special
 from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 from lawbench import budget
+from lawbench.claims import PAOLI_DISCONTINUITY
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
@@ -134,6 +135,7 @@ class LiuZhaoBrogliato(Law):
     )
     source = "Brogliato 2010, eqs. (32)-(48); Liu, Zhao, Brogliato 2008, 2009; Zhang et al. 2013"
     tags = Tags(friction=True, several_contacts=True, stiffness=True, accuracy_knob="tol")
+    findings = (PAOLI_DISCONTINUITY,)
     options = (
         Spec(
             "variant",
