@@ -15,11 +15,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
 
-from lawbench.case import CASES, Case, GroundTruth, Params, per_item
+from lawbench.case import CASES, Case, Params, per_item
 from lawbench.chains import (
-    NEWTONS_CRADLE,
-    PLASTIC_CHAIN,
     ball_velocities,
     chain_problem,
     exponent_spec,
@@ -28,9 +27,12 @@ from lawbench.chains import (
     restitution_spec,
     velocities_spec,
 )
+from lawbench.checks import Trial
 from lawbench.errors import InvalidProblem
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import decades, extremes
 from lawbench.tags import Tags
 
 
@@ -58,13 +60,7 @@ class BallChain(Case):
         gaps_spec(1),
     )
     requires = Tags(several_contacts=True)
-    ground_truth = GroundTruth(
-        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
-        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
-        "limits of the three-ball chain)",
-        law="compliant",
-        options={"rtol": 1e-10},
-    )
+    ground_truth = SPRINGS
     references = (PLASTIC_CHAIN, NEWTONS_CRADLE)
 
     examples = {
@@ -112,3 +108,36 @@ class BallChain(Case):
 
 
 CASES.register(BallChain())
+
+
+def striker_mass_ratio(trial: Trial) -> float:
+    """Mass of the striking ball over the struck one's."""
+    masses = trial.params["masses"]
+    return masses[0] / masses[1]
+
+
+_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
+STUDIES.register(
+    extremes(
+        "ball_chain_length",
+        "chain length (balls)",
+        "ball_chain",
+        "n",
+        grid={"n": [100], **_ELASTIC_AND_PLASTIC},
+        full={"grid": {"n": [10, 100, 1000], **_ELASTIC_AND_PLASTIC}},
+    )
+)
+# Two balls, one contact: every law, those that treat one contact only included.
+STUDIES.register(
+    extremes(
+        "ball_chain_masses",
+        "mass ratio of two balls (striker over struck)",
+        "ball_chain",
+        "mass_ratio",
+        grid={"masses": [[r, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
+        params={"n": 2},
+        laws="able",
+        measures={"mass_ratio": striker_mass_ratio},
+        full={"grid": {"masses": [[r, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
+    )
+)

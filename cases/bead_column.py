@@ -23,10 +23,14 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from lawbench.case import CASES, Case, GroundTruth, Params, per_item
+from lawbench.cases._chains import SPRINGS
+
+from lawbench.case import CASES, Case, Params, per_item
 from lawbench.chains import ball_velocities, chain_problem, restitution_spec
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import speed_accuracy
 from lawbench.tags import Tags
 
 BEAD_MASS = 2.05e-3
@@ -51,13 +55,7 @@ class BeadColumn(Case):
         restitution_spec(),
     )
     requires = Tags(several_contacts=True, stiffness=True)
-    ground_truth = GroundTruth(
-        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
-        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
-        "limits of the three-ball chain)",
-        law="compliant",
-        options={"rtol": 1e-10},
-    )
+    ground_truth = SPRINGS
     examples = {"default": {}, "one bead": {"n": 1}, "higher drop": {"drop_height": 5.1e-3}}
 
     def _check(self, params: dict[str, Any]) -> None:
@@ -81,3 +79,5 @@ class BeadColumn(Case):
 
 
 CASES.register(BeadColumn())
+
+STUDIES.register(speed_accuracy("bead_column"))

@@ -28,10 +28,13 @@ import math
 from typing import Any
 
 import numpy as np
+from lawbench.cases._friction import stronge
 
 from lawbench.case import CASES, Case, Params, Reference
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import decades, extremes, speed_accuracy
 from lawbench.tags import Tags
 
 _SOURCE = "Lubarda 2010 as given by Brogliato 2010, lamina on an anvil, eqs. (12)-(14)"
@@ -113,6 +116,11 @@ class Lamina(Case):
         Spec("mu", 0.5, "Coulomb friction coefficient", "", low=0.0),
     )
     requires = Tags(friction=True)
+    ground_truth = stronge(
+        "on the lamina the energetic coefficient is the energetically consistent one (a "
+        "Newton coefficient can exceed it and create energy), and Lubarda's closed form "
+        "-e sqrt(r) omega- is its answer wherever the lamina rebounds"
+    )
     references = (
         _termination("newton", lambda r: 1.0, "-e omega-"),
         _termination("poisson", lambda r: r, "-e r omega-"),
@@ -149,3 +157,37 @@ class Lamina(Case):
 
 
 CASES.register(Lamina())
+
+
+_ELASTIC_AND_PLASTIC = {"e": [0.0, 1.0]}
+for study in (
+    speed_accuracy("lamina"),
+    extremes(
+        "lamina_friction",
+        "large friction",
+        "lamina",
+        "mu",
+        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
+    ),
+    extremes(
+        "lamina_grazing",
+        "grazing speed [m/s]",
+        "lamina",
+        "transform",
+        grid=_ELASTIC_AND_PLASTIC,
+        transform="grazing",
+        values=decades(0, -12, -1),
+        slow=True,
+    ),
+    extremes(
+        "lamina_duplicated",
+        "contact 0 given twice",
+        "lamina",
+        "transform",
+        grid=_ELASTIC_AND_PLASTIC,
+        transform="duplicated",
+        values=(0,),
+        slow=True,
+    ),
+):
+    STUDIES.register(study)

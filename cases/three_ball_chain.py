@@ -12,11 +12,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
 
-from lawbench.case import CASES, Case, GroundTruth, Params, Reference, exactly, per_item
+from lawbench.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.chains import (
-    NEWTONS_CRADLE,
-    PLASTIC_CHAIN,
     ball_velocities,
     chain_problem,
     exponent_spec,
@@ -26,7 +25,16 @@ from lawbench.chains import (
     stiffness_ratio_spec,
     velocities_spec,
 )
+from lawbench.checks import Trial
 from lawbench.problem import ImpactProblem
+from lawbench.study import STUDIES
+from lawbench.study_shapes import (
+    continuity,
+    decades,
+    energy_shares,
+    extremes,
+    speed_accuracy,
+)
 from lawbench.tags import Tags
 
 
@@ -77,13 +85,7 @@ class ThreeBallChain(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
-    ground_truth = GroundTruth(
-        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
-        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
-        "limits of the three-ball chain)",
-        law="compliant",
-        options={"rtol": 1e-10},
-    )
+    ground_truth = SPRINGS
     references = (
         Reference(
             "eq. (29)",
@@ -137,3 +139,59 @@ class ThreeBallChain(Case):
 
 
 CASES.register(ThreeBallChain())
+
+
+def striker_mass_ratio(trial: Trial) -> float:
+    """Mass of the striking ball over the others'."""
+    masses = trial.params["masses"]
+    return masses[0] / masses[1]
+
+
+_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
+for study in (
+    extremes(
+        "three_ball_chain_stiffness",
+        "stiffness ratio",
+        "three_ball_chain",
+        "stiffness_ratio",
+        grid={"stiffness_ratio": decades(-8, 8, 4), **_ELASTIC_AND_PLASTIC},
+        full={"grid": {"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC}},
+    ),
+    extremes(
+        "three_ball_chain_masses",
+        "mass ratio (striker over the others)",
+        "three_ball_chain",
+        "mass_ratio",
+        grid={"masses": [[r, 1.0, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
+        measures={"mass_ratio": striker_mass_ratio},
+        full={"grid": {"masses": [[r, 1.0, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
+    ),
+    extremes(
+        "three_ball_chain_grazing",
+        "grazing speed [m/s]",
+        "three_ball_chain",
+        "transform",
+        grid=_ELASTIC_AND_PLASTIC,
+        transform="grazing",
+        values=decades(-4, -12, -4),
+        full={"transform_values": decades(0, -12, -1)},
+    ),
+    extremes(
+        "three_ball_chain_duplicated",
+        "contact 0 given twice",
+        "three_ball_chain",
+        "transform",
+        grid=_ELASTIC_AND_PLASTIC,
+        transform="duplicated",
+        values=(0,),
+    ),
+    speed_accuracy("three_ball_chain"),
+    energy_shares(
+        "three_ball_chain",
+        decades(-3, 3),
+        np.logspace(-3, 3, 25).tolist(),
+        name="dispersion",
+    ),
+    continuity("three_ball_chain"),
+):
+    STUDIES.register(study)

@@ -14,8 +14,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.cases._chains import SPRINGS
 
-from lawbench.case import CASES, Case, GroundTruth, Params, Reference, exactly, per_item
+from lawbench.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.chains import (
     ball_velocities,
     chain_problem,
@@ -27,6 +28,8 @@ from lawbench.chains import (
     velocities_spec,
 )
 from lawbench.problem import ImpactProblem
+from lawbench.study import STUDIES
+from lawbench.study_shapes import continuity, decades, energy_shares, extremes
 from lawbench.tags import Tags
 
 
@@ -99,13 +102,7 @@ class TwoBallsWall(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
-    ground_truth = GroundTruth(
-        why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
-        "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
-        "limits of the three-ball chain)",
-        law="compliant",
-        options={"rtol": 1e-10},
-    )
+    ground_truth = SPRINGS
     references = (
         Reference(
             "eq. (27)",
@@ -155,3 +152,39 @@ class TwoBallsWall(Case):
 
 
 CASES.register(TwoBallsWall())
+
+
+_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
+for study in (
+    energy_shares("two_balls_wall", decades(-3, 3), np.logspace(-3, 3, 25).tolist()),
+    continuity("two_balls_wall"),
+    extremes(
+        "two_balls_wall_stiffness",
+        "stiffness ratio (wall over balls)",
+        "two_balls_wall",
+        "stiffness_ratio",
+        grid={"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC},
+        slow=True,
+    ),
+    extremes(
+        "two_balls_wall_grazing",
+        "grazing speed [m/s]",
+        "two_balls_wall",
+        "transform",
+        grid=_ELASTIC_AND_PLASTIC,
+        transform="grazing",
+        values=decades(0, -12, -1),
+        slow=True,
+    ),
+    extremes(
+        "two_balls_wall_duplicated",
+        "contact 0 given twice",
+        "two_balls_wall",
+        "transform",
+        grid=_ELASTIC_AND_PLASTIC,
+        transform="duplicated",
+        values=(0,),
+        slow=True,
+    ),
+):
+    STUDIES.register(study)

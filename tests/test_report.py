@@ -17,6 +17,7 @@ import pandas as pd
 import pytest
 
 import lawbench
+from lawbench.guard import Guard
 from lawbench.report import QUICK, write_report
 from lawbench.report.extremes import (
     UNACCEPTABLE,
@@ -25,7 +26,6 @@ from lawbench.report.extremes import (
     grazing,
     verdict,
 )
-from lawbench.report.guard import Guard
 from lawbench.report.page import Figure, Section, Table, write_page
 from lawbench.report.plots import figure
 from lawbench.report.tradeoff import knob_values, pareto

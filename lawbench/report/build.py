@@ -19,6 +19,7 @@ import numpy as np
 import scipy
 
 import lawbench
+from lawbench.guard import Guard
 from lawbench.report import (
     dispersion,
     inside,
@@ -29,7 +30,6 @@ from lawbench.report import (
     tradeoff,
 )
 from lawbench.report.config import Config
-from lawbench.report.guard import Guard
 from lawbench.report.page import Figure, Section, save_figure, write_page
 from lawbench.report.runs import Context
 

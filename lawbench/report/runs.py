@@ -22,12 +22,13 @@ import numpy as np
 import pandas as pd
 
 from lawbench.case import CASES, Case
-from lawbench.grid import Row, RunSpec
+from lawbench.grid import RunSpec
+from lawbench.guard import TIME_OUT, Guard, Result
 from lawbench.law import LAWS, Law
 from lawbench.registry import Registry
 from lawbench.report.config import Config
-from lawbench.report.guard import TIME_OUT, Guard, Result
-from lawbench.runner import compute, run
+from lawbench.runner import Task, compute, run
+from lawbench.study import Job as Cell
 
 TIME_OUT_CLASS = "TimeOut"
 
@@ -41,9 +42,9 @@ class Job:
     params: dict[str, Any] = field(default_factory=dict)
     options: dict[str, Any] = field(default_factory=dict)
 
-    def row(self, index: int = 0) -> Row:
-        """The runner's row of this job."""
-        return Row(index, self.law, self.case, dict(self.params), dict(self.options))
+    def row(self, index: int = 0) -> Cell:
+        """The runner's cell of this job."""
+        return Cell(self.law, self.case, dict(self.params), dict(self.options))
 
 
 def failed_record(job: Job, error_class: str, message: str) -> dict[str, Any]:
@@ -157,7 +158,10 @@ class Context:
     def _guarded(self, jobs: Sequence[Job], checks: list, settings: dict, repeats: int) -> Callable:
         budget = self.config.budget_s
         handles = [
-            [self.guard.submit(compute, job.row(), checks, settings) for _ in range(repeats)]
+            [
+                self.guard.submit(compute, Task(0, job.row(), "", tuple(checks), settings))
+                for _ in range(repeats)
+            ]
             for job in jobs
         ]
 
@@ -193,7 +197,7 @@ class Context:
                 continue
             spec = RunSpec(grids, checks=checks, **extra)
             table, _ = run(
-                spec,
+                spec.plan(),
                 self.out / "runs" / f"{name}-r{repeat}.parquet",
                 executor=self.config.executor,
                 address=self.config.address,

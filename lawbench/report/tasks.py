@@ -15,7 +15,7 @@ from lawbench.api import evaluate
 from lawbench.checks.continuity import jumps
 from lawbench.law import LAWS
 from lawbench.problem import ImpactProblem
-from lawbench.runner import STEP_KEYS
+from lawbench.record import STEP_KEYS
 
 
 def solve_problem(law: str, problem: ImpactProblem, options: dict[str, Any]) -> dict[str, Any]:
