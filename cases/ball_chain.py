@@ -27,7 +27,6 @@ from lawbench.chains import (
     restitution_spec,
     velocities_spec,
 )
-from lawbench.checks import Trial
 from lawbench.errors import InvalidProblem
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
@@ -110,17 +109,11 @@ class BallChain(Case):
 CASES.register(BallChain())
 
 
-def striker_mass_ratio(trial: Trial) -> float:
-    """Mass of the striking ball over the struck one's."""
-    masses = trial.params["masses"]
-    return masses[0] / masses[1]
-
-
 _ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
 STUDIES.register(
     extremes(
         "ball_chain_length",
-        "chain length (balls)",
+        "chain length [balls]",
         "ball_chain",
         "n",
         grid={"n": [100], **_ELASTIC_AND_PLASTIC},
@@ -131,13 +124,12 @@ STUDIES.register(
 STUDIES.register(
     extremes(
         "ball_chain_masses",
-        "mass ratio of two balls (striker over struck)",
+        "striker's mass [kg], the struck ball 1 kg",
         "ball_chain",
-        "mass_ratio",
+        "masses",
         grid={"masses": [[r, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
         params={"n": 2},
         laws="able",
-        measures={"mass_ratio": striker_mass_ratio},
         full={"grid": {"masses": [[r, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
     )
 )

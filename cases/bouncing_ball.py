@@ -205,7 +205,7 @@ CASES.register(BouncingBall())
 STUDIES.register(
     extremes(
         "bouncing_ball_friction",
-        "large friction",
+        "friction coefficient mu",
         "bouncing_ball",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},

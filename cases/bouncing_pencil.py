@@ -160,7 +160,7 @@ CASES.register(BouncingPencil())
 STUDIES.register(
     extremes(
         "bouncing_pencil_friction",
-        "large friction",
+        "friction coefficient mu",
         "bouncing_pencil",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},

@@ -140,7 +140,7 @@ STUDIES.register(energy_map("double_pendulum", ("e", 0.0, 1.0), ("mu", 0.0, 1.5)
 STUDIES.register(
     extremes(
         "double_pendulum_friction",
-        "large friction",
+        "friction coefficient mu",
         "double_pendulum",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},

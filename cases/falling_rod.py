@@ -246,7 +246,7 @@ for study in (
     energy_map("falling_rod", ("angle", 5.0, 85.0), ("mu", 0.0, 1.5), params=_GAIN),
     extremes(
         "falling_rod_friction",
-        "large friction",
+        "friction coefficient mu",
         "falling_rod",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},

@@ -164,7 +164,7 @@ for study in (
     speed_accuracy("lamina"),
     extremes(
         "lamina_friction",
-        "large friction",
+        "friction coefficient mu",
         "lamina",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},

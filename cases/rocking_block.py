@@ -233,7 +233,7 @@ STUDIES.register(
 STUDIES.register(
     extremes(
         "rocking_block_friction",
-        "large friction",
+        "friction coefficient mu",
         "rocking_block",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},

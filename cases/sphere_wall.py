@@ -210,7 +210,7 @@ STUDIES.register(
 STUDIES.register(
     extremes(
         "sphere_wall_friction",
-        "large friction",
+        "friction coefficient mu",
         "sphere_wall",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},

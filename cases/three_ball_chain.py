@@ -25,7 +25,6 @@ from lawbench.chains import (
     stiffness_ratio_spec,
     velocities_spec,
 )
-from lawbench.checks import Trial
 from lawbench.problem import ImpactProblem
 from lawbench.study import STUDIES
 from lawbench.study_shapes import (
@@ -141,17 +140,11 @@ class ThreeBallChain(Case):
 CASES.register(ThreeBallChain())
 
 
-def striker_mass_ratio(trial: Trial) -> float:
-    """Mass of the striking ball over the others'."""
-    masses = trial.params["masses"]
-    return masses[0] / masses[1]
-
-
 _ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
 for study in (
     extremes(
         "three_ball_chain_stiffness",
-        "stiffness ratio",
+        "stiffness ratio (contact 1 over contact 0)",
         "three_ball_chain",
         "stiffness_ratio",
         grid={"stiffness_ratio": decades(-8, 8, 4), **_ELASTIC_AND_PLASTIC},
@@ -159,11 +152,10 @@ for study in (
     ),
     extremes(
         "three_ball_chain_masses",
-        "mass ratio (striker over the others)",
+        "striker's mass [kg], the others 1 kg",
         "three_ball_chain",
-        "mass_ratio",
+        "masses",
         grid={"masses": [[r, 1.0, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
-        measures={"mass_ratio": striker_mass_ratio},
         full={"grid": {"masses": [[r, 1.0, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
     ),
     extremes(

@@ -322,13 +322,16 @@ class Study:
                             for repeat in range(self.repeats):
                                 yield Job(law_name, case_name, params, options, transform, repeat)
 
-    def plan(self, laws: Sequence[str] | None = None, cases: Sequence[str] | None = None) -> Plan:
-        """The executor's plan of this study (restricted to ``laws`` and ``cases``)."""
+    def check_names(self) -> tuple[str, ...]:
+        """The checks deciding the verdicts (``checks``, or every single-solve check)."""
         from lawbench.checks import SINGLE_SOLVE
 
+        return tuple(SINGLE_SOLVE if self.checks is None else self.checks)
+
+    def plan(self, laws: Sequence[str] | None = None, cases: Sequence[str] | None = None) -> Plan:
+        """The executor's plan of this study (restricted to ``laws`` and ``cases``)."""
         jobs = list(self.jobs(laws, cases))
-        checks = tuple(SINGLE_SOLVE if self.checks is None else self.checks)
-        return Plan(self.name, jobs, checks, dict(self.settings), dict(self.measures))
+        return Plan(self.name, jobs, self.check_names(), dict(self.settings), dict(self.measures))
 
     def _check(self, case: Case, law: Law, params: dict, options: dict) -> None:
         try:
