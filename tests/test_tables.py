@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import ast
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -186,3 +188,32 @@ def test_table_is_study_and_list_names_every_study():
     result = lawbench_command("table", "nope")
     assert result.returncode == 2
     assert result.stderr.count("\n") == 1 and "unknown study 'nope'" in result.stderr
+
+
+ENGINE = ("study.py", "study_shapes.py", "runner.py", "record.py", "measures.py", "tables.py")
+ENGINE += ("transforms.py", "guard.py", "grid.py", "chains.py")
+
+
+def test_the_study_engine_and_the_report_name_no_law_or_scene():
+    """Studies, views and their shapes learn laws and scenes from the registries and from
+    the data declared with them; a name may appear in a docstring only."""
+    root = Path(lawbench.__file__).parent
+    names = set(lawbench.LAWS.names()) | set(lawbench.CASES.names())
+    paths = [root / name for name in ENGINE] + sorted((root / "report").glob("*.py"))
+    hits = []
+    for path in paths:
+        tree = ast.parse(path.read_text())
+        docs = {
+            id(node.body[0].value)
+            for node in ast.walk(tree)
+            if isinstance(getattr(node, "body", None), list)
+            and node.body
+            and isinstance(node.body[0], ast.Expr)
+            and isinstance(node.body[0].value, ast.Constant)
+        }
+        hits += [
+            f"{path.name}:{node.lineno} {node.value!r}"
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Constant) and node.value in names and id(node) not in docs
+        ]
+    assert not hits

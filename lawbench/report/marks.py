@@ -56,8 +56,3 @@ class Mark:
 def legend() -> list[Mark]:
     """One mark per class, its name as text and its meaning as reason."""
     return [Mark(str(v), v, MEANINGS[v]) for v in Verdict]
-
-
-def legend_text() -> str:
-    """The legend in words (for Markdown and captions)."""
-    return "; ".join(f"{GLYPHS[v]} {v}: {MEANINGS[v]}" for v in Verdict)
