@@ -38,7 +38,7 @@ from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import spatial_column
 from lawbench.spec import Spec
 from lawbench.study import STUDIES
-from lawbench.study_shapes import extremes
+from lawbench.study_shapes import large_friction
 from lawbench.tags import Tags
 
 # Jia's scenes are stated in his model: its tangential compliance at the scene's eta0^2.
@@ -202,12 +202,4 @@ class BouncingBall(Case):
 
 BouncingBall.references = (frictionless_reference(BouncingBall),)
 CASES.register(BouncingBall())
-STUDIES.register(
-    extremes(
-        "bouncing_ball_friction",
-        "friction coefficient mu",
-        "bouncing_ball",
-        "mu",
-        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
-    )
-)
+STUDIES.register(large_friction("bouncing_ball"))

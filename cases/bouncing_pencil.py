@@ -46,7 +46,7 @@ from lawbench.case import CASES, Case, Params, exactly
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
 from lawbench.study import STUDIES
-from lawbench.study_shapes import extremes
+from lawbench.study_shapes import large_friction
 from lawbench.tags import Tags
 
 SPEED = 5.0
@@ -157,12 +157,4 @@ class BouncingPencil(Case):
 
 BouncingPencil.references = (frictionless_reference(BouncingPencil),)
 CASES.register(BouncingPencil())
-STUDIES.register(
-    extremes(
-        "bouncing_pencil_friction",
-        "friction coefficient mu",
-        "bouncing_pencil",
-        "mu",
-        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
-    )
-)
+STUDIES.register(large_friction("bouncing_pencil"))

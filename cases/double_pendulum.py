@@ -39,7 +39,7 @@ from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
 from lawbench.study import STUDIES
-from lawbench.study_shapes import energy_map, extremes
+from lawbench.study_shapes import energy_map, large_friction
 from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
@@ -137,12 +137,4 @@ class DoublePendulum(Case):
 CASES.register(DoublePendulum())
 
 STUDIES.register(energy_map("double_pendulum", ("e", 0.0, 1.0), ("mu", 0.0, 1.5)))
-STUDIES.register(
-    extremes(
-        "double_pendulum_friction",
-        "friction coefficient mu",
-        "double_pendulum",
-        "mu",
-        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
-    )
-)
+STUDIES.register(large_friction("double_pendulum"))

@@ -52,7 +52,13 @@ from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
 from lawbench.study import STUDIES
-from lawbench.study_shapes import decades, energy_map, extremes, speed_accuracy
+from lawbench.study_shapes import (
+    duplicated_contact,
+    energy_map,
+    grazing,
+    large_friction,
+    speed_accuracy,
+)
 from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
@@ -240,35 +246,11 @@ CASES.register(FallingRod())
 
 
 _GAIN = {k: v for k, v in FallingRod.examples["energy gain"].items() if k not in ("angle", "mu")}
-_ELASTIC_AND_PLASTIC = {"e": [0.0, 1.0]}
 for study in (
     speed_accuracy("falling_rod"),
     energy_map("falling_rod", ("angle", 5.0, 85.0), ("mu", 0.0, 1.5), params=_GAIN),
-    extremes(
-        "falling_rod_friction",
-        "friction coefficient mu",
-        "falling_rod",
-        "mu",
-        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
-    ),
-    extremes(
-        "falling_rod_grazing",
-        "grazing speed [m/s]",
-        "falling_rod",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="grazing",
-        values=decades(-4, -12, -4),
-        full={"transform_values": decades(0, -12, -1)},
-    ),
-    extremes(
-        "falling_rod_duplicated",
-        "contact 0 given twice",
-        "falling_rod",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="duplicated",
-        values=(0,),
-    ),
+    large_friction("falling_rod"),
+    grazing("falling_rod", [0.0, 1.0]),
+    duplicated_contact("falling_rod", [0.0, 1.0]),
 ):
     STUDIES.register(study)

@@ -34,7 +34,12 @@ from lawbench.case import CASES, Case, Params, Reference
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
 from lawbench.study import STUDIES
-from lawbench.study_shapes import decades, extremes, speed_accuracy
+from lawbench.study_shapes import (
+    duplicated_contact,
+    grazing,
+    large_friction,
+    speed_accuracy,
+)
 from lawbench.tags import Tags
 
 _SOURCE = "Lubarda 2010 as given by Brogliato 2010, lamina on an anvil, eqs. (12)-(14)"
@@ -159,35 +164,10 @@ class Lamina(Case):
 CASES.register(Lamina())
 
 
-_ELASTIC_AND_PLASTIC = {"e": [0.0, 1.0]}
 for study in (
     speed_accuracy("lamina"),
-    extremes(
-        "lamina_friction",
-        "friction coefficient mu",
-        "lamina",
-        "mu",
-        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
-    ),
-    extremes(
-        "lamina_grazing",
-        "grazing speed [m/s]",
-        "lamina",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="grazing",
-        values=decades(0, -12, -1),
-        slow=True,
-    ),
-    extremes(
-        "lamina_duplicated",
-        "contact 0 given twice",
-        "lamina",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="duplicated",
-        values=(0,),
-        slow=True,
-    ),
+    large_friction("lamina"),
+    grazing("lamina", [0.0, 1.0], slow=True),
+    duplicated_contact("lamina", [0.0, 1.0], slow=True),
 ):
     STUDIES.register(study)

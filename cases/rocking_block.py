@@ -51,7 +51,7 @@ from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
 from lawbench.study import STUDIES, Study
-from lawbench.study_shapes import extremes
+from lawbench.study_shapes import large_friction
 from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
@@ -230,12 +230,4 @@ STUDIES.register(
         measures={"omega_ratio": omega_ratio, "housner": housner, "difference": from_housner},
     )
 )
-STUDIES.register(
-    extremes(
-        "rocking_block_friction",
-        "friction coefficient mu",
-        "rocking_block",
-        "mu",
-        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
-    )
-)
+STUDIES.register(large_friction("rocking_block"))

@@ -37,7 +37,7 @@ from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import spatial_column
 from lawbench.spec import Spec
 from lawbench.study import STUDIES, Study
-from lawbench.study_shapes import decades, extremes
+from lawbench.study_shapes import grazing, large_friction
 from lawbench.tags import Tags
 
 NORMAL = np.array([0.0, 1.0, 0.0])
@@ -207,24 +207,5 @@ STUDIES.register(
         },
     )
 )
-STUDIES.register(
-    extremes(
-        "sphere_wall_friction",
-        "friction coefficient mu",
-        "sphere_wall",
-        "mu",
-        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
-    )
-)
-STUDIES.register(
-    extremes(
-        "sphere_wall_grazing",
-        "grazing speed [m/s]",
-        "sphere_wall",
-        "transform",
-        grid={"e": [0.0, 1.0]},
-        transform="grazing",
-        values=decades(0, -12, -1),
-        slow=True,
-    )
-)
+STUDIES.register(large_friction("sphere_wall"))
+STUDIES.register(grazing("sphere_wall", [0.0, 1.0], slow=True))

@@ -30,8 +30,10 @@ from lawbench.study import STUDIES
 from lawbench.study_shapes import (
     continuity,
     decades,
+    duplicated_contact,
     energy_shares,
     extremes,
+    grazing,
     speed_accuracy,
 )
 from lawbench.tags import Tags
@@ -158,25 +160,8 @@ for study in (
         grid={"masses": [[r, 1.0, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
         full={"grid": {"masses": [[r, 1.0, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
     ),
-    extremes(
-        "three_ball_chain_grazing",
-        "grazing speed [m/s]",
-        "three_ball_chain",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="grazing",
-        values=decades(-4, -12, -4),
-        full={"transform_values": decades(0, -12, -1)},
-    ),
-    extremes(
-        "three_ball_chain_duplicated",
-        "contact 0 given twice",
-        "three_ball_chain",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="duplicated",
-        values=(0,),
-    ),
+    grazing("three_ball_chain", _ELASTIC_AND_PLASTIC["e"]),
+    duplicated_contact("three_ball_chain", _ELASTIC_AND_PLASTIC["e"]),
     speed_accuracy("three_ball_chain"),
     energy_shares(
         "three_ball_chain",

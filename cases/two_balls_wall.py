@@ -29,7 +29,14 @@ from lawbench.chains import (
 )
 from lawbench.problem import ImpactProblem
 from lawbench.study import STUDIES
-from lawbench.study_shapes import continuity, decades, energy_shares, extremes
+from lawbench.study_shapes import (
+    continuity,
+    decades,
+    duplicated_contact,
+    energy_shares,
+    extremes,
+    grazing,
+)
 from lawbench.tags import Tags
 
 
@@ -166,25 +173,7 @@ for study in (
         grid={"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC},
         slow=True,
     ),
-    extremes(
-        "two_balls_wall_grazing",
-        "grazing speed [m/s]",
-        "two_balls_wall",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="grazing",
-        values=decades(0, -12, -1),
-        slow=True,
-    ),
-    extremes(
-        "two_balls_wall_duplicated",
-        "contact 0 given twice",
-        "two_balls_wall",
-        "transform",
-        grid=_ELASTIC_AND_PLASTIC,
-        transform="duplicated",
-        values=(0,),
-        slow=True,
-    ),
+    grazing("two_balls_wall", _ELASTIC_AND_PLASTIC["e"], slow=True),
+    duplicated_contact("two_balls_wall", _ELASTIC_AND_PLASTIC["e"], slow=True),
 ):
     STUDIES.register(study)

@@ -217,6 +217,18 @@ def _regress(args: argparse.Namespace) -> None:
     print("regress: every law holds its baseline")
 
 
+def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
+    """The options of the commands that run many cells: executor, workers, guard."""
+    parser.add_argument("--executor", choices=EXECUTORS, default=default)
+    parser.add_argument("--workers", type=int, help="worker processes (default: one per core)")
+    parser.add_argument(
+        "--max-seconds",
+        type=float,
+        default=BUDGET_S,
+        help=f"wall-clock guard of one cell, in seconds (default {BUDGET_S:g})",
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lawbench`` command."""
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
@@ -285,14 +297,7 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument(
         "--out", metavar="FILE", help="write the whole table (.parquet, else CSV) to FILE"
     )
-    study.add_argument("--executor", choices=EXECUTORS, default="serial")
-    study.add_argument("--workers", type=int, help="worker processes (default: one per core)")
-    study.add_argument(
-        "--max-seconds",
-        type=float,
-        default=BUDGET_S,
-        help=f"wall-clock guard of one cell, in seconds (default {BUDGET_S:g})",
-    )
+    _executor_arguments(study, "serial")
     study.set_defaults(run=_study)
     run = commands.add_parser("run", help="run a grid of laws x cases x parameters")
     run.add_argument("spec", nargs="?", help="a TOML run specification")
@@ -308,15 +313,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=int, default=0, help="seed of random samples")
     run.add_argument("--out", help="output file (default results.parquet)")
     run.add_argument("--format", choices=("parquet", "csv"), default="parquet")
-    run.add_argument("--executor", choices=EXECUTORS, default="processes")
+    _executor_arguments(run, "processes")
     run.add_argument("--address", help="address of a Dask scheduler (default: a local cluster)")
-    run.add_argument("--workers", type=int, help="worker processes (default: one per core)")
-    run.add_argument(
-        "--max-seconds",
-        type=float,
-        default=BUDGET_S,
-        help=f"wall-clock guard of one row, in seconds (default {BUDGET_S:g})",
-    )
     run.add_argument("--resume", action="store_true", help="compute only the missing rows")
     run.add_argument("--chunk-size", type=int, default=50, help="rows written per chunk file")
     run.set_defaults(run=_run)

@@ -89,6 +89,50 @@ def extremes(
     )
 
 
+def grazing(case: str, e: Sequence[Any], slow: bool = False) -> Study:
+    """Every law on ``case`` with its approach made grazing, for each restitution of ``e``.
+
+    Fastest approach 1e-4, 1e-8 and 1e-12 m/s (every decade from 1 to 1e-12 in the full
+    report), the motion the contacts do not see kept (`lawbench.transforms.grazing`).
+    """
+    return extremes(
+        f"{case}_grazing",
+        "grazing speed [m/s]",
+        case,
+        "transform",
+        grid={"e": list(e)},
+        transform="grazing",
+        values=decades(-4, -12, -4),
+        full={"transform_values": decades(0, -12, -1)},
+        slow=slow,
+    )
+
+
+def duplicated_contact(case: str, e: Sequence[Any], slow: bool = False) -> Study:
+    """Every law on ``case`` with its contact 0 given twice, for each restitution of ``e``."""
+    return extremes(
+        f"{case}_duplicated",
+        "contact 0 given twice",
+        case,
+        "transform",
+        grid={"e": list(e)},
+        transform="duplicated",
+        values=(0,),
+        slow=slow,
+    )
+
+
+def large_friction(case: str) -> Study:
+    """Every law on ``case`` at mu = 0 and mu = 1000, each with e = 0 and e = 1."""
+    return extremes(
+        f"{case}_friction",
+        "friction coefficient mu",
+        case,
+        "mu",
+        grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
+    )
+
+
 def energy_map(
     case: str,
     x: tuple[str, float, float],
