@@ -16,9 +16,8 @@ from pathlib import Path
 from lawbench.case import CASES, Case
 from lawbench.checks import run_checks
 from lawbench.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
-from lawbench.guard import alarm
+from lawbench.guard import BUDGET_S, EXECUTORS, alarm
 from lawbench.law import LAWS, Law
-from lawbench.runner import BUDGET_S, EXECUTORS
 from lawbench.serialize import trial_record
 from lawbench.study import STUDIES, Job
 

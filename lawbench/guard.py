@@ -35,6 +35,10 @@ TIME_OUT = "time-out"
 WARNINGS_KEPT = 10
 # The budget a guard kill names.
 WALL_CLOCK = "wall-clock guard"
+# Seconds a cell may run before the guard stops it, unless told otherwise.
+BUDGET_S = 600.0
+# Where guarded cells run (`lawbench.runner.Executor`): this process, local workers, Dask.
+EXECUTORS = ("serial", "processes", "dask")
 
 
 def stopped(seconds: float) -> BudgetExceeded:

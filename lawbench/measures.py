@@ -35,11 +35,11 @@ _SOLVED: dict[str, np.ndarray | None] = {}
 
 
 def _digest(problem: ImpactProblem) -> str:
-    parts = [problem.M, problem.Wn, problem.v, problem.gaps]
-    if problem.Wt is not None:
-        parts.append(problem.Wt)
-    text = "".join(np.ascontiguousarray(p, dtype=float).tobytes().hex() for p in parts)
-    return hashlib.sha1((text + repr(problem.contacts)).encode()).hexdigest()
+    digest = hashlib.sha1(repr(problem.contacts).encode())
+    for part in (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps):
+        if part is not None:
+            digest.update(np.ascontiguousarray(part, dtype=float).tobytes())
+    return digest.hexdigest()
 
 
 def _solve(law: str, options: dict[str, Any], problem: ImpactProblem) -> np.ndarray | None:

@@ -31,13 +31,18 @@ import pandas as pd
 
 from lawbench.checks import run_checks
 from lawbench.errors import InvalidProblem
-from lawbench.guard import TIME_OUT, WARNINGS_KEPT, Guard, Result, alarm, stopped
+from lawbench.guard import (
+    BUDGET_S,
+    EXECUTORS,
+    TIME_OUT,
+    WARNINGS_KEPT,
+    Guard,
+    Result,
+    alarm,
+    stopped,
+)
 from lawbench.record import Record
 from lawbench.study import Job, Measure, Plan
-
-EXECUTORS = ("serial", "processes", "dask")
-# Seconds a cell may run before the guard stops it, unless told otherwise.
-BUDGET_S = 600.0
 
 
 class WorkerDied(Exception):

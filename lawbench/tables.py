@@ -18,8 +18,9 @@ from typing import Any
 import pandas as pd
 
 from lawbench.errors import InvalidProblem
+from lawbench.guard import BUDGET_S
 from lawbench.record import budget_text
-from lawbench.runner import BUDGET_S, Executor, collect
+from lawbench.runner import Executor, collect
 from lawbench.study import STUDIES, Study
 from lawbench.transforms import parse
 
