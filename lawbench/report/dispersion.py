@@ -133,6 +133,7 @@ def _continuity(case: Case, study: Study, table: pd.DataFrame) -> list[Any]:
             )
         ax.axhline(CONTINUOUS, color="k", linestyle=":", linewidth=0.8)
         ax.set(xscale="log", yscale="log", title=f"perturbed {kind}", xlabel=units[kind])
+        ax.set_ylim(bottom=plots.FLOOR / 10)
         ax.set_ylabel(JUMP_LABEL)
     axes[0, 0].legend(fontsize="x-small")
     sizes = json.dumps(list(study.settings.get("continuity_sizes", [])))

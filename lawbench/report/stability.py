@@ -137,14 +137,14 @@ def _errors_figure(frame: pd.DataFrame) -> Figure:
     laws = list(dict.fromkeys(frame["law"]))
     panels = (
         ("momentum", "change of a conserved momentum (relative)"),
-        ("energy", "energy created dT / T- (where > 0)"),
+        ("energy", "energy created max(dT, 0) / T-"),
     )
     for ax, (column, name) in zip(axes[0], panels, strict=True):
         for k, law in enumerate(laws):
             values = frame.loc[frame["law"] == law, column].to_numpy(dtype=float)
             values = values[np.isfinite(values)]
             if column == "energy":
-                values = values[values > 0]
+                values = np.maximum(values, 0.0)
             spread = np.linspace(-0.25, 0.25, len(values)) if len(values) > 1 else [0.0]
             style = plots.law_style(law)
             ax.plot(
@@ -157,11 +157,13 @@ def _errors_figure(frame: pd.DataFrame) -> Figure:
             )
         ax.set_xticks(range(len(laws)), laws, rotation=45, ha="right")
         ax.set(yscale="log", ylabel=f"{name}, dimensionless")
+        ax.set_ylim(bottom=plots.FLOOR / 10)
     data = frame[["law", "row", "value", "momentum", "energy", "verdict"]]
     return Figure(
         "stability_errors",
         "Momentum and energy checks' values of every answered cell of the stability grid, per "
-        f"law (exact zeros drawn at {plots.FLOOR:g}); their verdicts are in the grids below.",
+        f"law (zeros, and energy kept or lost, drawn at {plots.FLOOR:g}); their verdicts are "
+        "in the grids below.",
         fig,
         data.reset_index(drop=True),
     )
