@@ -98,13 +98,17 @@ def _row(result: Result, task: Task, budget_s: float) -> dict[str, Any]:
 _WORKER_GUARD: Guard | None = None
 
 
-def _dask_chunk(tasks: list[Task], budget_s: float) -> list[dict[str, Any]]:
-    """Rows of a chunk of cells, each run in this Dask worker's guard process."""
+def _dask_chunk(chunk: list[tuple[int, Task]], budget_s: float) -> list[tuple[int, dict]]:
+    """``(position, row)`` of a chunk of cells, each run in this Dask worker's guard process."""
     global _WORKER_GUARD
     if _WORKER_GUARD is None:
         _WORKER_GUARD = Guard(1, budget_s)
-    handles = {_WORKER_GUARD.submit(compute, task, budget=budget_s): task for task in tasks}
-    return [_row(r, handles[h], budget_s) for h, r in _WORKER_GUARD.as_completed(handles)]
+    handles = {_WORKER_GUARD.submit(compute, task, budget=budget_s): k for k, task in chunk}
+    tasks = dict(chunk)
+    return [
+        (handles[h], _row(r, tasks[handles[h]], budget_s))
+        for h, r in _WORKER_GUARD.as_completed(handles)
+    ]
 
 
 def _daemonic() -> bool:
@@ -184,16 +188,15 @@ class Executor:
     def _dask(self, tasks: Sequence[Task]) -> Iterator[tuple[int, dict[str, Any]]]:
         from dask.distributed import as_completed
 
-        positions = {task.index: k for k, task in enumerate(tasks)}
+        numbered = list(enumerate(tasks))
         futures = [
             self._client.submit(
-                _dask_chunk, list(tasks[start : start + self.chunk_size]), self.budget_s, pure=False
+                _dask_chunk, numbered[start : start + self.chunk_size], self.budget_s, pure=False
             )
-            for start in range(0, len(tasks), self.chunk_size)
+            for start in range(0, len(numbered), self.chunk_size)
         ]
         for future in as_completed(futures):
-            for row in future.result():
-                yield positions[row["index"]], row
+            yield from future.result()
 
     def _connect(self) -> None:
         import dask

@@ -11,7 +11,7 @@ import lawbench
 from lawbench.grid import RunSpec, values
 from lawbench.guard import Guard
 from lawbench.record import budget_text
-from lawbench.runner import Task, compute, run
+from lawbench.runner import Executor, Task, compute, run, run_many
 from lawbench.study import Job, Plan
 from lawbench.transforms import apply, parse, spell
 
@@ -249,3 +249,19 @@ def test_a_grid_can_transform_its_rows():
     (job,) = spec.rows()
     assert job.transform == "duplicated"
     assert compute(Task(0, job, "", ("momentum",)))["momentum_verdict"] == "holds"
+
+
+@pytest.mark.parametrize("executor", ["processes", "dask"])
+def test_several_plans_through_one_pool_keep_their_cells_apart(tmp_path, executor):
+    """Every plan's cells are numbered from 0: the pool must not mix them up."""
+    plans = [
+        Plan("one", [Job("newton", "three_ball_chain", {"e": [e]}) for e in (0.0, 0.5, 1.0)]),
+        Plan("two", [Job("poisson", "two_balls_wall", {"e": [e]}) for e in (0.2, 0.4)]),
+    ]
+    outs = [(plan, tmp_path / f"{plan.name}.parquet") for plan in plans]
+    with Executor(executor, workers=2, chunk_size=2) as pool:
+        results = run_many(outs, pool)
+    for plan, (table, computed) in zip(plans, results, strict=True):
+        assert computed == len(plan.jobs)
+        assert list(table["study"]) == [plan.name] * len(plan.jobs)
+        assert list(table["key"]) == [job.key for job in plan.jobs]
