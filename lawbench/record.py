@@ -75,7 +75,31 @@ def _lists(value: Any) -> Any:
 
 @dataclass
 class Record:
-    """The result of one cell (see the module docstring for the columns it adds)."""
+    """The result of one cell.
+
+    Attributes
+    ----------
+    index, key, study : int, str, str
+        The cell's place in its run, its stable identity (for resuming) and its study.
+    law, case, params, options, transform, repeat
+        The cell (`lawbench.study.Job`); parameters and options as JSON text.
+    verdict : str
+        The worst verdict of its checks, or that of the error that stopped it.
+    status, error_class, error_message : str
+        The law's status word, or 'error' with the error's class and message.
+    budget, budget_amount, spent_s : str, float, float
+        For a `BudgetExceeded`: the budget that ran out, its amount, the seconds spent.
+    v_plus, Pn, Pt : str
+        The outcome's vectors, as JSON text.
+    T_minus, T_plus, dT : float
+        Kinetic energies before and after, and the change (J).
+    formulation, steps, wall_time_s, warnings
+        How the law solved it, its steps or iterations, its own wall time, warnings raised.
+    exit_status, reproducer : int, str
+        The ``lawbench solve`` command that reruns the cell, and the exit status it gives.
+    checks, measures : dict
+        Check results and measured values, flattened into columns by `row`.
+    """
 
     index: int
     key: str
