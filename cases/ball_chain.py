@@ -15,12 +15,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.cases._ground_truths import SPRING_CHAIN
+from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
 
 from lawbench.case import CASES, Case, Params, per_item
 from lawbench.chains import (
-    NEWTONS_CRADLE,
-    PLASTIC_CHAIN,
     ball_velocities,
     chain_problem,
     exponent_spec,
@@ -32,6 +30,8 @@ from lawbench.chains import (
 from lawbench.errors import InvalidProblem
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import decades, extremes
 from lawbench.tags import Tags
 
 
@@ -59,7 +59,7 @@ class BallChain(Case):
         gaps_spec(1),
     )
     requires = Tags(several_contacts=True)
-    ground_truth = SPRING_CHAIN
+    ground_truth = SPRINGS
     references = (PLASTIC_CHAIN, NEWTONS_CRADLE)
 
     examples = {
@@ -107,3 +107,29 @@ class BallChain(Case):
 
 
 CASES.register(BallChain())
+
+
+_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
+STUDIES.register(
+    extremes(
+        "ball_chain_length",
+        "chain length [balls]",
+        "ball_chain",
+        "n",
+        grid={"n": [100], **_ELASTIC_AND_PLASTIC},
+        full={"grid": {"n": [10, 100, 1000], **_ELASTIC_AND_PLASTIC}},
+    )
+)
+# Two balls, one contact: every law, those that treat one contact only included.
+STUDIES.register(
+    extremes(
+        "ball_chain_masses",
+        "striker's mass [kg], the struck ball 1 kg",
+        "ball_chain",
+        "masses",
+        grid={"masses": [[r, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
+        params={"n": 2},
+        laws="able",
+        full={"grid": {"masses": [[r, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
+    )
+)

@@ -23,12 +23,14 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from lawbench.cases._ground_truths import SPRING_CHAIN
+from lawbench.cases._chains import SPRINGS
 
 from lawbench.case import CASES, Case, Params, per_item
 from lawbench.chains import ball_velocities, chain_problem, restitution_spec
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import speed_accuracy
 from lawbench.tags import Tags
 
 BEAD_MASS = 2.05e-3
@@ -53,7 +55,7 @@ class BeadColumn(Case):
         restitution_spec(),
     )
     requires = Tags(several_contacts=True, stiffness=True)
-    ground_truth = SPRING_CHAIN
+    ground_truth = SPRINGS
     examples = {"default": {}, "one bead": {"n": 1}, "higher drop": {"drop_height": 5.1e-3}}
 
     def _check(self, params: dict[str, Any]) -> None:
@@ -77,3 +79,5 @@ class BeadColumn(Case):
 
 
 CASES.register(BeadColumn())
+
+STUDIES.register(speed_accuracy("bead_column"))

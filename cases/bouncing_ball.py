@@ -33,12 +33,22 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, exactly
+from lawbench.case import CASES, Case, GroundTruth, Params, Reference, exactly
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import spatial_column
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import large_friction
 from lawbench.tags import Tags
 
+# Jia's scenes are stated in his model: its tangential compliance at the scene's eta0^2.
+TANGENTIAL_COMPLIANCE = GroundTruth(
+    why="the example is stated in Jia's model: normal and tangential springs at the contact "
+    "whose stiffness ratio eta0^2 is a parameter of the scene, which rigid Coulomb laws do not "
+    "read (Jia, IJRR 2013); the law integrated at its tightest tolerance",
+    law="jia",
+    options={"tol": 1e-12},
+)
 COORDINATES = ["vx [m/s]", "vy [m/s]", "vz [m/s]", "wx [rad/s]", "wy [rad/s]", "wz [rad/s]"]
 MINDLIN_RATIO = (2 - 0.3) / (2 * (1 - 0.3))
 
@@ -155,6 +165,7 @@ class BouncingBall(Case):
         *contact_specs(0.5, 0.4, MINDLIN_RATIO),
     )
     requires = Tags(friction=True, spatial=True)
+    ground_truth = TANGENTIAL_COMPLIANCE
     references = ()  # set after the class: the reference builds the scene itself
     examples = {
         "default": {},
@@ -191,3 +202,4 @@ class BouncingBall(Case):
 
 BouncingBall.references = (frictionless_reference(BouncingBall),)
 CASES.register(BouncingBall())
+STUDIES.register(large_friction("bouncing_ball"))

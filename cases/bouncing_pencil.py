@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from lawbench.cases.bouncing_ball import (
     COORDINATES,
+    TANGENTIAL_COMPLIANCE,
     body_on_table,
     contact_point_momentum,
     contact_specs,
@@ -44,6 +45,8 @@ from lawbench.cases.bouncing_ball import (
 from lawbench.case import CASES, Case, Params, exactly
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import large_friction
 from lawbench.tags import Tags
 
 SPEED = 5.0
@@ -119,6 +122,7 @@ class BouncingPencil(Case):
         *contact_specs(0.5, 0.8, 1.2),
     )
     requires = Tags(friction=True, spatial=True)
+    ground_truth = TANGENTIAL_COMPLIANCE
     references = ()  # set after the class: the reference builds the scene itself
     examples = {
         "default": {},
@@ -153,3 +157,4 @@ class BouncingPencil(Case):
 
 BouncingPencil.references = (frictionless_reference(BouncingPencil),)
 CASES.register(BouncingPencil())
+STUDIES.register(large_friction("bouncing_pencil"))

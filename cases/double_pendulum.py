@@ -32,11 +32,14 @@ import math
 from typing import Any
 
 import numpy as np
+from lawbench.cases._friction import stronge
 
 from lawbench.case import CASES, Case, Params, exactly
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import energy_map, large_friction
 from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
@@ -99,6 +102,10 @@ class DoublePendulum(Case):
         Spec("mu", 0.5, "Coulomb friction coefficient", "", "float", 0.0),
     )
     requires = Tags(friction=True)
+    ground_truth = stronge(
+        "Kane and Levinson's pendulum is the classic case where the impulse-level law gains "
+        "energy and the impulse-time dynamics do not"
+    )
     examples = {
         "default": {},
         "plastic": {"e": 0.0},
@@ -128,3 +135,6 @@ class DoublePendulum(Case):
 
 
 CASES.register(DoublePendulum())
+
+STUDIES.register(energy_map("double_pendulum", ("e", 0.0, 1.0), ("mu", 0.0, 1.5)))
+STUDIES.register(large_friction("double_pendulum"))

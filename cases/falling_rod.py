@@ -45,11 +45,20 @@ import math
 from typing import Any
 
 import numpy as np
+from lawbench.cases._friction import stronge
 
 from lawbench.case import CASES, Case, Params, Reference, exactly
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import (
+    duplicated_contact,
+    energy_map,
+    grazing,
+    large_friction,
+    speed_accuracy,
+)
 from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
@@ -176,6 +185,9 @@ class FallingRod(Case):
         Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
     )
     requires = Tags(friction=True)
+    ground_truth = stronge(
+        "on the rod the normal-tangential coupling can reverse the slip (the remark after eq. 9)"
+    )
     references = (
         *(
             Reference(
@@ -231,3 +243,14 @@ class FallingRod(Case):
 
 
 CASES.register(FallingRod())
+
+
+_GAIN = {k: v for k, v in FallingRod.examples["energy gain"].items() if k not in ("angle", "mu")}
+for study in (
+    speed_accuracy("falling_rod"),
+    energy_map("falling_rod", ("angle", 5.0, 85.0), ("mu", 0.0, 1.5), params=_GAIN),
+    large_friction("falling_rod"),
+    grazing("falling_rod", [0.0, 1.0]),
+    duplicated_contact("falling_rod", [0.0, 1.0]),
+):
+    STUDIES.register(study)

@@ -28,10 +28,18 @@ import math
 from typing import Any
 
 import numpy as np
+from lawbench.cases._friction import stronge
 
 from lawbench.case import CASES, Case, Params, Reference
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
+from lawbench.study import STUDIES
+from lawbench.study_shapes import (
+    duplicated_contact,
+    grazing,
+    large_friction,
+    speed_accuracy,
+)
 from lawbench.tags import Tags
 
 _SOURCE = "Lubarda 2010 as given by Brogliato 2010, lamina on an anvil, eqs. (12)-(14)"
@@ -113,6 +121,11 @@ class Lamina(Case):
         Spec("mu", 0.5, "Coulomb friction coefficient", "", low=0.0),
     )
     requires = Tags(friction=True)
+    ground_truth = stronge(
+        "on the lamina the energetic coefficient is the energetically consistent one (a "
+        "Newton coefficient can exceed it and create energy), and Lubarda's closed form "
+        "-e sqrt(r) omega- is its answer wherever the lamina rebounds"
+    )
     references = (
         _termination("newton", lambda r: 1.0, "-e omega-"),
         _termination("poisson", lambda r: r, "-e r omega-"),
@@ -149,3 +162,12 @@ class Lamina(Case):
 
 
 CASES.register(Lamina())
+
+
+for study in (
+    speed_accuracy("lamina"),
+    large_friction("lamina"),
+    grazing("lamina", [0.0, 1.0], slow=True),
+    duplicated_contact("lamina", [0.0, 1.0], slow=True),
+):
+    STUDIES.register(study)

@@ -45,10 +45,13 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference
+from lawbench.case import CASES, Case, GroundTruth, Params, Reference
+from lawbench.checks import Trial
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import planar_column, planar_tangent
 from lawbench.spec import Spec
+from lawbench.study import STUDIES, Study
+from lawbench.study_shapes import large_friction
 from lawbench.tags import Tags
 
 FLOOR = np.array([0.0, 1.0])
@@ -135,6 +138,12 @@ class RockingBlock(Case):
         Spec("mu", 0.5, "Coulomb friction coefficient of both corners", "", "float", 0.0),
     )
     requires = Tags(friction=True, several_contacts=True)
+    ground_truth = GroundTruth(
+        why="Housner's plastic impact is exact where its premises hold (e = 0, the landing "
+        "corner sticks, the pivot lifts off: width <= sqrt(2) height): angular momentum about "
+        "the landing corner is kept; elsewhere the scene has no ground truth",
+        reference="Housner",
+    )
     # Both laws hold the landing corner with Newton's normal rule and Coulomb's friction on the
     # post-impact slip; without friction whittaker is moreau's unilateral law.
     references = tuple(
@@ -191,3 +200,34 @@ class RockingBlock(Case):
 
 
 CASES.register(RockingBlock())
+
+
+def omega_ratio(trial: Trial) -> float:
+    """``omega+ / omega-``."""
+    return float(trial.outcome.v_plus[2] / trial.problem.v[2])
+
+
+def housner(trial: Trial) -> float:
+    """Housner's ``omega+ / omega-`` at the trial's width and height."""
+    return housner_ratio(trial.params["width"], trial.params["height"])
+
+
+def from_housner(trial: Trial) -> float:
+    """``omega+ / omega-`` minus Housner's."""
+    return omega_ratio(trial) - housner(trial)
+
+
+STUDIES.register(
+    Study(
+        name="rocking_block",
+        title="rocking block: omega+/omega- against Housner's 1 - 3/2 sin^2(alpha), e = 0, "
+        "height 1 m, width 0.1 to 10 m (so width/height 0.1 to 10), mu in {0, 1}; Housner's "
+        "formula holds for width <= sqrt(2) height (wider, the pivot cannot lift off)",
+        cases=("rocking_block",),
+        laws="every",
+        grid={"mu": [0.0, 1.0], "width": np.logspace(-1.0, 1.0, 9).tolist()},
+        params={"height": 1.0, "e": 0.0},
+        measures={"omega_ratio": omega_ratio, "housner": housner, "difference": from_housner},
+    )
+)
+STUDIES.register(large_friction("rocking_block"))

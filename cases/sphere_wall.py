@@ -29,11 +29,15 @@ import math
 from typing import Any
 
 import numpy as np
+from lawbench.cases._friction import stronge
 
 from lawbench.case import CASES, Case, Params, Reference, exactly
+from lawbench.checks import Trial
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.rigid import spatial_column
 from lawbench.spec import Spec
+from lawbench.study import STUDIES, Study
+from lawbench.study_shapes import grazing, large_friction
 from lawbench.tags import Tags
 
 NORMAL = np.array([0.0, 1.0, 0.0])
@@ -105,6 +109,7 @@ class SphereWall(Case):
         Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
     )
     requires = Tags(friction=True, spatial=True)
+    ground_truth = stronge("on the sphere the slip direction turns during the impact")
     references = (
         Reference(
             "eq. (11)",
@@ -153,3 +158,54 @@ class SphereWall(Case):
 
 
 CASES.register(SphereWall())
+
+
+def _slip_direction(trial: Trial) -> np.ndarray:
+    return trial.problem.ut / np.linalg.norm(trial.problem.ut)
+
+
+def slip_before(trial: Trial) -> float:
+    """Pre-impact slip speed of the contact point (m/s)."""
+    return float(np.linalg.norm(trial.problem.ut))
+
+
+def slip_after(trial: Trial) -> float:
+    """Post-impact slip of the contact point along the pre-impact slip (m/s; < 0 reversed)."""
+    return float(trial.problem.Wt.T @ trial.outcome.v_plus @ _slip_direction(trial))
+
+
+def spin_after(trial: Trial) -> float:
+    """Post-impact spin about n x s (rad/s; rolling along s is radius spin = vt)."""
+    slip = _slip_direction(trial)
+    axis = np.cross(NORMAL, slip[0] * TANGENTS[0] + slip[1] * TANGENTS[1])
+    return float(trial.outcome.v_plus[3:] @ axis)
+
+
+def impulse_ratio(trial: Trial) -> float:
+    """Tangential over normal impulse along the pre-impact slip, ``-Pt.s / Pn``."""
+    return float(-trial.outcome.Pt @ _slip_direction(trial) / trial.outcome.Pn[0])
+
+
+_DEFAULTS = SphereWall().parameters()
+STUDIES.register(
+    Study(
+        name="sphere_wall",
+        title="sphere on a wall, no pre-impact spin, incidence 5 to 85 degrees: post-impact "
+        "slip ut_plus (m/s) along the pre-impact slip, spin about n x s (rad/s), impulse ratio "
+        f"-Pt.s/Pn; e = {_DEFAULTS['e']:g}, e_t = {_DEFAULTS['e_t']:g}, "
+        f"mu = {_DEFAULTS['mu']:g}, speed = {_DEFAULTS['speed']:g} m/s, "
+        f"radius = {_DEFAULTS['radius']:g} m",
+        cases=("sphere_wall",),
+        laws=("brach", "whittaker", "darboux_keller"),
+        grid={"angle": np.linspace(5.0, 85.0, 9).tolist()},
+        params={"spin": [0.0, 0.0, 0.0]},
+        measures={
+            "ut_minus": slip_before,
+            "ut_plus": slip_after,
+            "spin_plus": spin_after,
+            "impulse_ratio": impulse_ratio,
+        },
+    )
+)
+STUDIES.register(large_friction("sphere_wall"))
+STUDIES.register(grazing("sphere_wall", [0.0, 1.0], slow=True))

@@ -12,12 +12,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.cases._ground_truths import SPRING_CHAIN
+from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
 
 from lawbench.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.chains import (
-    NEWTONS_CRADLE,
-    PLASTIC_CHAIN,
     ball_velocities,
     chain_problem,
     exponent_spec,
@@ -28,6 +26,16 @@ from lawbench.chains import (
     velocities_spec,
 )
 from lawbench.problem import ImpactProblem
+from lawbench.study import STUDIES
+from lawbench.study_shapes import (
+    continuity,
+    decades,
+    duplicated_contact,
+    energy_shares,
+    extremes,
+    grazing,
+    speed_accuracy,
+)
 from lawbench.tags import Tags
 
 
@@ -78,7 +86,7 @@ class ThreeBallChain(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
-    ground_truth = SPRING_CHAIN
+    ground_truth = SPRINGS
     references = (
         Reference(
             "eq. (29)",
@@ -132,3 +140,35 @@ class ThreeBallChain(Case):
 
 
 CASES.register(ThreeBallChain())
+
+
+_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
+for study in (
+    extremes(
+        "three_ball_chain_stiffness",
+        "stiffness ratio (contact 1 over contact 0)",
+        "three_ball_chain",
+        "stiffness_ratio",
+        grid={"stiffness_ratio": decades(-8, 8, 4), **_ELASTIC_AND_PLASTIC},
+        full={"grid": {"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC}},
+    ),
+    extremes(
+        "three_ball_chain_masses",
+        "striker's mass [kg], the others 1 kg",
+        "three_ball_chain",
+        "masses",
+        grid={"masses": [[r, 1.0, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
+        full={"grid": {"masses": [[r, 1.0, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
+    ),
+    grazing("three_ball_chain", _ELASTIC_AND_PLASTIC["e"]),
+    duplicated_contact("three_ball_chain", _ELASTIC_AND_PLASTIC["e"]),
+    speed_accuracy("three_ball_chain"),
+    energy_shares(
+        "three_ball_chain",
+        decades(-3, 3),
+        np.logspace(-3, 3, 25).tolist(),
+        name="dispersion",
+    ),
+    continuity("three_ball_chain"),
+):
+    STUDIES.register(study)

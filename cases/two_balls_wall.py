@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.cases._ground_truths import SPRING_CHAIN
+from lawbench.cases._chains import SPRINGS
 
 from lawbench.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.chains import (
@@ -28,6 +28,15 @@ from lawbench.chains import (
     velocities_spec,
 )
 from lawbench.problem import ImpactProblem
+from lawbench.study import STUDIES
+from lawbench.study_shapes import (
+    continuity,
+    decades,
+    duplicated_contact,
+    energy_shares,
+    extremes,
+    grazing,
+)
 from lawbench.tags import Tags
 
 
@@ -100,7 +109,7 @@ class TwoBallsWall(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
-    ground_truth = SPRING_CHAIN
+    ground_truth = SPRINGS
     references = (
         Reference(
             "eq. (27)",
@@ -150,3 +159,21 @@ class TwoBallsWall(Case):
 
 
 CASES.register(TwoBallsWall())
+
+
+_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
+for study in (
+    energy_shares("two_balls_wall", decades(-3, 3), np.logspace(-3, 3, 25).tolist()),
+    continuity("two_balls_wall"),
+    extremes(
+        "two_balls_wall_stiffness",
+        "stiffness ratio (wall over balls)",
+        "two_balls_wall",
+        "stiffness_ratio",
+        grid={"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC},
+        slow=True,
+    ),
+    grazing("two_balls_wall", _ELASTIC_AND_PLASTIC["e"], slow=True),
+    duplicated_contact("two_balls_wall", _ELASTIC_AND_PLASTIC["e"], slow=True),
+):
+    STUDIES.register(study)

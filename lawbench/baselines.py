@@ -21,7 +21,7 @@ import pandas as pd
 
 from lawbench.errors import InvalidProblem
 from lawbench.grid import RunSpec
-from lawbench.runner import compute
+from lawbench.runner import Task, compute
 
 BASELINES = Path(__file__).resolve().parent.parent / "reports" / "baselines"
 QUANTITIES = ("v_plus", "Pn", "Pt", "T_plus")
@@ -50,12 +50,13 @@ def compute_table(
 
     Vectors are JSON and numbers their shortest exact repr, so the CSV keeps every digit.
     """
-    rows = [
-        row
-        for row in spec.rows()
-        if (not laws or row.law in laws) and (not cases or row.case in cases)
+    jobs = [
+        job
+        for job in spec.rows()
+        if (not laws or job.law in laws) and (not cases or job.case in cases)
     ]
-    table = pd.DataFrame([compute(row, [], {}) for row in rows]).reindex(columns=COLUMNS)
+    records = [compute(Task(index, job)) for index, job in enumerate(jobs)]
+    table = pd.DataFrame(records).reindex(columns=COLUMNS)
     table["T_plus"] = table["T_plus"].map(lambda x: "" if pd.isna(x) else repr(float(x)))
     return table.fillna("").astype(str)
 

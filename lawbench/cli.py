@@ -19,9 +19,12 @@ from lawbench.api import evaluate
 from lawbench.case import CASES, Case
 from lawbench.checks import run_checks
 from lawbench.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
+from lawbench.guard import BUDGET_S, EXECUTORS, alarm
 from lawbench.law import LAWS, Law
 from lawbench.problem import ImpactProblem
 from lawbench.serialize import trial_record
+from lawbench.study import STUDIES, Job
+from lawbench.transforms import apply
 
 
 class Drift(LawbenchError):
@@ -186,8 +189,12 @@ def _export(args: argparse.Namespace) -> None:
 def _solve(args: argparse.Namespace) -> None:
     case, params = _scene_or_problem(args)
     options = _assignments(args.option, "--option")
-    trial = evaluate(args.law, case, options, **params)
-    record = trial_record(trial, run_checks(trial))
+    with alarm(args.max_seconds):
+        if isinstance(case, str):
+            trial = Job(args.law, case, params, options, args.transform or "").solve()
+        else:
+            trial = evaluate(args.law, apply(args.transform or "", case), options)
+        record = trial_record(trial, run_checks(trial))
     if args.json:
         print(json.dumps(record, indent=2, allow_nan=False))
         return
@@ -215,17 +222,20 @@ def _report(args: argparse.Namespace) -> None:
     print(f"report written to {path}")
 
 
-def _table(args: argparse.Namespace) -> None:
-    from lawbench.tables import build_table
+def _study(args: argparse.Namespace) -> None:
+    from lawbench.tables import study_table
 
-    table = build_table(args.name)
+    if args.list:
+        for study in STUDIES:
+            print(f"  {study.name:<32} {study.title}")
+        return
+    if not args.name:
+        raise InvalidProblem("study: give a study's name, or --list")
+    given = _assignments(args.set, "--set")
+    table = study_table(args.name, given, args.executor, args.workers, args.max_seconds)
     print(table.text())
     if args.out:
-        try:
-            path = table.write_csv(Path(args.out))
-        except OSError as exc:
-            raise InvalidProblem(f"--out {args.out}: cannot write ({exc.strerror})") from None
-        print(f"table written to {path}")
+        print(f"table written to {table.write(Path(args.out))}")
 
 
 def _run(args: argparse.Namespace) -> None:
@@ -239,7 +249,7 @@ def _run(args: argparse.Namespace) -> None:
     spec = inline if spec is None else spec
     out = Path(args.out or ("results." + args.format))
     table, computed = run(
-        spec,
+        spec.plan(),
         out,
         args.executor,
         args.address,
@@ -247,6 +257,7 @@ def _run(args: argparse.Namespace) -> None:
         args.format,
         args.chunk_size,
         args.workers,
+        args.max_seconds,
     )
     failed = int((table["error_class"].fillna("") != "").sum()) if len(table) else 0
     print(f"{len(table)} rows in {out} ({computed} computed now, {failed} failed)")
@@ -310,6 +321,18 @@ def _regress(args: argparse.Namespace) -> None:
     print("regress: every law holds its baseline")
 
 
+def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
+    """The options of the commands that run many cells: executor, workers, guard."""
+    parser.add_argument("--executor", choices=EXECUTORS, default=default)
+    parser.add_argument("--workers", type=int, help="worker processes (default: one per core)")
+    parser.add_argument(
+        "--max-seconds",
+        type=float,
+        default=BUDGET_S,
+        help=f"wall-clock guard of one cell, in seconds (default {BUDGET_S:g})",
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lawbench`` command."""
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
@@ -334,6 +357,17 @@ def build_parser() -> argparse.ArgumentParser:
     )
     solve.add_argument(
         "--option", action="append", default=[], metavar="NAME=VALUE", help="a law option"
+    )
+    solve.add_argument(
+        "--transform",
+        metavar="NAME=VALUE",
+        help="a transform of the built problem (grazing=SPEED, duplicated=CONTACT)",
+    )
+    solve.add_argument(
+        "--max-seconds",
+        type=float,
+        metavar="S",
+        help="stop the solve after S seconds of wall time (exit code 4)",
     )
     solve.add_argument("--json", action="store_true", help="print one JSON object")
     solve.set_defaults(run=_solve)
@@ -370,10 +404,23 @@ def build_parser() -> argparse.ArgumentParser:
     )
     report.set_defaults(mode="quick")
     report.set_defaults(run=_report)
-    table = commands.add_parser("table", help="tabulate a study of several laws (CSV)")
-    table.add_argument("name", help="rocking_block, sphere_wall or dispersion")
-    table.add_argument("--out", metavar="FILE", help="write the table as CSV to FILE")
-    table.set_defaults(run=_table)
+    study = commands.add_parser(
+        "study", aliases=["table"], help="run one study and print its table (table: the same)"
+    )
+    study.add_argument("name", nargs="?", help="a study (lawbench study --list)")
+    study.add_argument("--list", action="store_true", help="list the studies with their titles")
+    study.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="fix a scene parameter (a swept one is no longer swept)",
+    )
+    study.add_argument(
+        "--out", metavar="FILE", help="write the whole table (.parquet, else CSV) to FILE"
+    )
+    _executor_arguments(study, "serial")
+    study.set_defaults(run=_study)
     run = commands.add_parser("run", help="run a grid of laws x cases x parameters")
     run.add_argument("spec", nargs="?", help="a TOML run specification")
     run.add_argument("--laws", help="comma-separated laws (default: every law that applies)")
@@ -388,9 +435,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=int, default=0, help="seed of random samples")
     run.add_argument("--out", help="output file (default results.parquet)")
     run.add_argument("--format", choices=("parquet", "csv"), default="parquet")
-    run.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes")
+    _executor_arguments(run, "processes")
     run.add_argument("--address", help="address of a Dask scheduler (default: a local cluster)")
-    run.add_argument("--workers", type=int, help="worker processes (default: one per core)")
     run.add_argument("--resume", action="store_true", help="compute only the missing rows")
     run.add_argument("--chunk-size", type=int, default=50, help="rows written per chunk file")
     run.set_defaults(run=_run)

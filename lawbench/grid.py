@@ -15,20 +15,24 @@ A specification is a TOML file (or the same built from the command line)::
     cases = ["*"]
     examples = true                           # each case's named examples as parameter sets
 
+    [[grid]]
+    cases = ["three_ball_chain"]
+    transforms = ["grazing=1e-08", "duplicated"]   # lawbench.transforms, one per row
+
 A parameter or option takes a list of values, one value, ``{range = [start, stop, count]}``
 (evenly spaced), ``{logrange = [start_exponent, stop_exponent, count]}`` (powers of ten), or
 ``{random = [low, high, count], log = false, size = 1}`` (uniform samples, drawn from the
 spec's seed and the grid, parameter and draw position, so the same spec always gives the same
 values; ``size`` > 1 draws vectors). Rows are the Cartesian product in the order written:
-cases, then laws, then parameters, then options. Every row is checked before any work: an
-unknown name or a value out of range raises `InvalidProblem`.
+cases, then laws, then parameters, then options, then transforms. Every row is checked before
+any work: an unknown name or a value out of range raises `InvalidProblem`. A row is a
+`lawbench.study.Job`; `RunSpec.plan` gives the executor's plan (`lawbench.runner.run`).
 """
 
 from __future__ import annotations
 
 import hashlib
 import itertools
-import json
 import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -41,23 +45,8 @@ from lawbench.case import CASES
 from lawbench.checks import CHECKS, SINGLE_SOLVE
 from lawbench.errors import InvalidProblem
 from lawbench.law import LAWS
-
-
-@dataclass(frozen=True)
-class Row:
-    """One unit of work: a law with options on a case with parameters."""
-
-    index: int
-    law: str
-    case: str
-    params: dict[str, Any]
-    options: dict[str, Any]
-
-    @property
-    def key(self) -> str:
-        """A stable identity of the row's content, for resuming."""
-        text = json.dumps([self.law, self.case, self.params, self.options], sort_keys=True)
-        return hashlib.sha1(text.encode()).hexdigest()[:16]
+from lawbench.study import Job, Plan
+from lawbench.transforms import parse
 
 
 @dataclass(frozen=True)
@@ -96,16 +85,21 @@ class RunSpec:
         sizes = tuple(float(s) for s in data.get("continuity_sizes", (1e-2, 1e-4, 1e-6)))
         return cls(grids, int(data.get("seed", 0)), checks, sizes)
 
-    def rows(self) -> list[Row]:
+    def rows(self) -> list[Job]:
         """Every row, in order, each checked against its law and case."""
-        rows: list[Row] = []
-        for number, grid in enumerate(self.grids):
-            for law, case, params, options in _expand(grid, self.seed, number):
-                rows.append(Row(len(rows), law, case, params, options))
-        return rows
+        return [
+            job
+            for number, grid in enumerate(self.grids)
+            for job in _expand(grid, self.seed, number)
+        ]
+
+    def plan(self) -> Plan:
+        """The executor's plan: every row, the checks, their settings; no measures."""
+        settings = {"continuity_sizes": list(self.continuity_sizes)}
+        return Plan("", self.rows(), tuple(self.checks), settings)
 
 
-GRID_KEYS = {"laws", "cases", "params", "options", "examples"}
+GRID_KEYS = {"laws", "cases", "params", "options", "examples", "transforms"}
 
 
 def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
@@ -119,7 +113,7 @@ def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
     return list(names)
 
 
-def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[tuple]:
+def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
     unknown = set(grid) - GRID_KEYS
     if unknown:
         raise InvalidProblem(f"spec grid {number}: unknown key {sorted(unknown)[0]!r}")
@@ -132,6 +126,9 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[tuple]:
     option_grids = dict(grid.get("options", {}))
     for law in option_grids:
         LAWS.get(law)
+    transforms = list(grid.get("transforms", [""]))
+    for spelling in filter(None, transforms):
+        parse(spelling)
     for case_name in cases:
         case = CASES.get(case_name)
         for law_name in laws:
@@ -156,7 +153,8 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[tuple]:
                         raise InvalidProblem(
                             f"spec grid {number}, {law_name} on {case_name}: {exc}"
                         ) from None
-                    yield law_name, case_name, params, options
+                    for transform in transforms:
+                        yield Job(law_name, case_name, params, options, transform)
 
 
 def _product(choices: Mapping[str, list[Any]]) -> Iterator[dict[str, Any]]:

@@ -1,86 +1,235 @@
-"""Execute a run: every row of a specification, one tidy record each, written as it finishes.
+"""The executor: every study cell and every ``lawbench run`` row, one record each, one guard.
 
-A row never raises: a failure is recorded with its error class and message and the run goes
-on. Records are written in chunks (Parquet, or CSV on request) into ``OUT.parts/`` as they
+`compute` solves one cell (`lawbench.study.Job`), runs its checks and measures, and returns
+its `lawbench.record.Record` row; it never raises: a failure is recorded with its error class
+and message and the run goes on (nevergrad's runner does the same). An `Executor` runs cells
+in this process (``serial``), in local worker processes (``processes``) or on a Dask cluster
+(``dask``), every cell under the same per-job wall-clock guard (`lawbench.guard`): a cell
+stopped there is a *budget* cell naming the ``wall-clock guard`` and its seconds.
+
+`run` writes a plan's records in chunks (Parquet, or CSV on request) into ``OUT.parts/`` as they
 finish, each chunk file written whole before it appears, so a run that is interrupted (Ctrl-C,
-a killed process) keeps every finished chunk, and a resumed run computes only the rows that are
-missing. When every row is done the chunks are gathered, sorted by row index, into ``OUT``.
-The table is the same whichever executor ran it (serial, local processes, or a Dask cluster),
-up to the ``wall_time_s`` column.
+a killed process) keeps every finished cell, and a resumed run computes only the cells that are
+missing. When every cell is done the chunks are gathered, sorted by cell index, into ``OUT``.
+The table is the same whichever executor ran it, up to the timing columns (``wall_time_s``,
+``spent_s``).
 """
 
 from __future__ import annotations
 
-import json
+import multiprocessing
 import os
 import sys
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+import warnings
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
-from lawbench.api import evaluate
 from lawbench.checks import run_checks
 from lawbench.errors import InvalidProblem
-from lawbench.grid import Row, RunSpec
-from lawbench.verdicts import Verdict, of_error
-
-EXECUTORS = ("serial", "processes", "dask")
-STEP_KEYS = ("steps", "impacts", "iterations")
-
-
-def compute(row: Row, checks: Sequence[str], settings: dict[str, Any]) -> dict[str, Any]:
-    """The record of one row: outcome, checks, cost, or the error that stopped it."""
-    record: dict[str, Any] = {
-        "index": row.index,
-        "key": row.key,
-        "law": row.law,
-        "case": row.case,
-        "params": json.dumps(row.params, sort_keys=True),
-        "options": json.dumps(row.options, sort_keys=True),
-        "status": "error",
-        "verdict": str(Verdict.HOLDS),
-        "error_class": "",
-        "error_message": "",
-    }
-    try:
-        trial = evaluate(row.law, row.case, row.options, **row.params)
-        trial.settings.update(settings)
-        results = run_checks(trial, list(checks))
-    except Exception as exc:  # a row records its failure and the run goes on
-        record.update(
-            verdict=str(of_error(exc)), error_class=type(exc).__name__, error_message=str(exc)
-        )
-        return record
-    outcome = trial.outcome
-    diagnostics = outcome.diagnostics
-    record.update(
-        status=outcome.status,
-        v_plus=json.dumps(outcome.v_plus.tolist()),
-        Pn=json.dumps(outcome.Pn.tolist()),
-        Pt=json.dumps(outcome.Pt.tolist()),
-        T_minus=outcome.T_minus,
-        T_plus=outcome.T_plus,
-        dT=outcome.dT,
-        formulation=str(diagnostics.get("formulation", "")),
-        steps=next((int(diagnostics[k]) for k in STEP_KEYS if k in diagnostics), 0),
-        wall_time_s=diagnostics["wall_time_s"],
-    )
-    for name, result in results.items():
-        record[f"{name}_value"] = np.nan if result.value is None else float(result.value)
-        record[f"{name}_verdict"] = str(result.verdict)
-        claims = trial.law.findings if result.verdict == Verdict.LAW_PROPERTY else ()
-        record[f"{name}_finding"] = claims.index(result.claim) if result.claim in claims else -1
-    return record
+from lawbench.guard import (
+    BUDGET_S,
+    EXECUTORS,
+    TIME_OUT,
+    WARNINGS_KEPT,
+    Guard,
+    Result,
+    alarm,
+    stopped,
+)
+from lawbench.record import Record
+from lawbench.study import Job, Measure, Plan
 
 
-def compute_chunk(rows: Sequence[Row], checks: Sequence[str], settings: dict) -> list[dict]:
-    """Records of a chunk of rows (the unit sent to a worker)."""
-    return [compute(row, checks, settings) for row in rows]
+class WorkerDied(Exception):
+    """A worker process ended while it computed a cell (a crash in compiled code)."""
+
+
+@dataclass(frozen=True)
+class Task:
+    """A cell with what to compute on it: the unit sent to a worker."""
+
+    index: int
+    job: Job
+    study: str = ""
+    checks: tuple[str, ...] = ()
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    measures: Mapping[str, Measure] = field(default_factory=dict)
+
+
+def compute(task: Task, alarm_s: float | None = None) -> dict[str, Any]:
+    """The record row of one cell: outcome, checks, measures, cost, or the error that stopped it.
+
+    ``alarm_s`` guards the cell in this process (`lawbench.guard.alarm`).
+    """
+    start = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            with alarm(alarm_s):
+                trial = task.job.solve(task.settings)
+                checks = run_checks(trial, list(task.checks)) if task.checks else {}
+                measures = {name: measure(trial) for name, measure in task.measures.items()}
+            record = Record.solved(task.index, task.study, task.job, trial, checks, measures)
+        except Exception as exc:  # a cell records its failure and the run goes on
+            spent = time.perf_counter() - start
+            record = Record.failed(task.index, task.study, task.job, exc, spent)
+    seen = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
+    record.warnings = "; ".join(seen[:WARNINGS_KEPT])
+    return record.row()
+
+
+def _row(result: Result, task: Task, budget_s: float) -> dict[str, Any]:
+    """The row of a cell computed in a guarded worker."""
+    if result.status == "ok":
+        return result.value
+    if result.status == TIME_OUT:
+        error: Exception = stopped(budget_s)
+    else:
+        error = WorkerDied(f"{result.error_class}: {result.error_message}")
+    return Record.failed(task.index, task.study, task.job, error, result.seconds).row()
+
+
+# The guard of a Dask worker process, started with its first chunk.
+_WORKER_GUARD: Guard | None = None
+
+
+def _dask_chunk(chunk: list[tuple[int, Task]], budget_s: float) -> list[tuple[int, dict]]:
+    """``(position, row)`` of a chunk of cells, each run in this Dask worker's guard process."""
+    global _WORKER_GUARD
+    if _WORKER_GUARD is None:
+        _WORKER_GUARD = Guard(1, budget_s)
+    handles = {_WORKER_GUARD.submit(compute, task, budget=budget_s): k for k, task in chunk}
+    tasks = dict(chunk)
+    return [
+        (handles[h], _row(r, tasks[handles[h]], budget_s))
+        for h, r in _WORKER_GUARD.as_completed(handles)
+    ]
+
+
+def _daemonic() -> bool:
+    return bool(multiprocessing.current_process().daemon)
+
+
+class Executor:
+    """Runs cells under the per-job wall-clock guard, in one of `EXECUTORS`.
+
+    Parameters
+    ----------
+    kind : str
+        'serial' (this process), 'processes' (local workers) or 'dask' (a local cluster, or the
+        scheduler at ``address``).
+    workers : int, optional
+        Worker processes (default: one per core).
+    budget_s : float
+        Seconds a cell may run before the guard stops it.
+    address : str, optional
+        A Dask scheduler's address.
+    chunk_size : int
+        Cells per Dask task.
+
+    Raises
+    ------
+    InvalidProblem
+        For an unknown kind, an unreachable Dask scheduler, or Dask workers that cannot start
+        the guard's process (daemonic workers).
+    """
+
+    def __init__(
+        self,
+        kind: str = "serial",
+        workers: int | None = None,
+        budget_s: float = BUDGET_S,
+        address: str | None = None,
+        chunk_size: int = 50,
+    ) -> None:
+        if kind not in EXECUTORS:
+            raise InvalidProblem(f"executor {kind!r}: must be one of {', '.join(EXECUTORS)}")
+        self.kind, self.budget_s, self.address = kind, budget_s, address
+        self.workers = workers or os.cpu_count() or 1
+        self.chunk_size = chunk_size
+        self._guard: Guard | None = None
+        self._client: Any = None
+        self._cluster: Any = None
+
+    def __enter__(self) -> Executor:
+        if self.kind == "processes":
+            self._guard = Guard(self.workers, self.budget_s)
+        elif self.kind == "dask":
+            self._connect()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._guard is not None:
+            self._guard.close()
+        if self._client is not None:
+            self._client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+
+    def run(self, tasks: Sequence[Task]) -> Iterator[tuple[int, dict[str, Any]]]:
+        """``(position in tasks, row)`` of every task, in the order they finish."""
+        if self.kind == "serial":
+            for position, task in enumerate(tasks):
+                yield position, compute(task, self.budget_s)
+        elif self.kind == "processes":
+            assert self._guard is not None, "use the executor in a with block"
+            handles = {self._guard.submit(compute, task): k for k, task in enumerate(tasks)}
+            for handle, result in self._guard.as_completed(handles):
+                position = handles[handle]
+                yield position, _row(result, tasks[position], self.budget_s)
+        else:
+            yield from self._dask(tasks)
+
+    def _dask(self, tasks: Sequence[Task]) -> Iterator[tuple[int, dict[str, Any]]]:
+        from dask.distributed import as_completed
+
+        numbered = list(enumerate(tasks))
+        futures = [
+            self._client.submit(
+                _dask_chunk, numbered[start : start + self.chunk_size], self.budget_s, pure=False
+            )
+            for start in range(0, len(numbered), self.chunk_size)
+        ]
+        for future in as_completed(futures):
+            yield from future.result()
+
+    def _connect(self) -> None:
+        try:
+            import dask
+            from dask.distributed import Client, LocalCluster
+        except ImportError:  # an optional dependency: say how to get it
+            raise InvalidProblem(
+                "the dask executor needs Dask: pip install 'lawbench[dask]'"
+            ) from None
+
+        try:
+            if self.address:
+                self._client = Client(self.address, timeout="10s")
+            else:
+                # The guard starts a process inside each worker: the workers must not be
+                # daemonic processes, which may not have children.
+                with dask.config.set({"distributed.worker.daemon": False}):
+                    self._cluster = LocalCluster(
+                        n_workers=self.workers,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=None,
+                    )
+                self._client = Client(self._cluster)
+        except OSError as exc:
+            raise InvalidProblem(
+                f"dask scheduler {self.address!r} cannot be reached ({exc})"
+            ) from None
+        if any(self._client.run(_daemonic).values()):
+            raise InvalidProblem(
+                "the dask workers are daemonic processes and cannot start the per-job guard: "
+                "start them with the setting distributed.worker.daemon = False"
+            )
 
 
 class Store:
@@ -90,6 +239,7 @@ class Store:
         self.out = Path(out)
         self.parts = self.out.with_name(self.out.name + ".parts")
         self.format = file_format
+        self.written = len(list(self.parts.glob("part-*"))) if self.parts.exists() else 0
 
     def done(self) -> pd.DataFrame:
         """Every record finished so far (final table and chunk files)."""
@@ -100,26 +250,34 @@ class Store:
             return pd.DataFrame()
         return pd.concat(frames, ignore_index=True).drop_duplicates("key")
 
-    def write_chunk(self, records: list[dict], number: int) -> None:
+    def write_chunk(self, records: list[dict]) -> None:
         """Write one chunk whole under a temporary name, then move it in place."""
         self.parts.mkdir(parents=True, exist_ok=True)
-        path = self.parts / f"part-{number:06d}.{self.format}"
+        path = self.parts / f"part-{self.written:06d}.{self.format}"
         temporary = path.with_suffix(".tmp")
         self._write(pd.DataFrame(records), temporary)
         os.replace(temporary, path)
+        self.written += 1
 
     def finish(self, total: int) -> pd.DataFrame:
-        """Gather the chunks by row index; when all ``total`` rows are done, write ``out``."""
-        table = self.done().sort_values("index").reset_index(drop=True)
+        """Gather the chunks by cell index; when all ``total`` cells are done, write ``out``."""
+        table = self.done()
+        if not len(table):
+            return table
+        table = table.sort_values("index").reset_index(drop=True)
         if len(table) == total:
+            self.out.parent.mkdir(parents=True, exist_ok=True)
             self._write(table, self.out)
             for path in self.parts.glob("part-*"):
                 path.unlink()
-            self.parts.rmdir()
+            if self.parts.exists():
+                self.parts.rmdir()
         return table
 
     def _read(self, path: Path) -> pd.DataFrame:
-        return pd.read_parquet(path) if self.format == "parquet" else pd.read_csv(path)
+        if self.format == "parquet":
+            return pd.read_parquet(path)
+        return pd.read_csv(path, keep_default_na=False, na_values=[""])
 
     def _write(self, table: pd.DataFrame, path: Path) -> None:
         if self.format == "parquet":
@@ -129,24 +287,25 @@ class Store:
 
 
 class Progress:
-    """Rows done, failures and time left, on a terminal only."""
+    """Cells done, failures and time left, on a terminal only."""
 
-    def __init__(self, total: int, stream: Any = sys.stderr) -> None:
-        self.total, self.stream = total, stream
+    def __init__(self, total: int, done: int, stream: Any = sys.stderr) -> None:
+        self.total, self.done, self.stream = total, done, stream
         self.enabled = stream.isatty()
         self.start = time.monotonic()
-        self.done = self.failed = 0
+        self.computed = self.failed = 0
 
-    def update(self, records: list[dict]) -> None:
-        """Count a finished chunk and redraw the line."""
-        self.done += len(records)
-        self.failed += sum(r["error_class"] != "" for r in records)
+    def update(self, row: dict) -> None:
+        """Count a finished cell and redraw the line."""
+        self.done += 1
+        self.computed += 1
+        self.failed += row["error_class"] != ""
         if not self.enabled:
             return
         elapsed = time.monotonic() - self.start
-        left = elapsed / self.done * (self.total - self.done)
+        left = elapsed / self.computed * (self.total - self.done)
         self.stream.write(
-            f"\r{self.done}/{self.total} rows, {self.failed} failed, "
+            f"\r{self.done}/{self.total} cells, {self.failed} failed, "
             f"{elapsed:.0f} s elapsed, about {left:.0f} s left "
         )
         self.stream.flush()
@@ -157,13 +316,69 @@ class Progress:
             self.stream.write("\n")
 
 
-def _chunks(rows: Sequence[Row], size: int) -> Iterator[list[Row]]:
-    for start in range(0, len(rows), size):
-        yield list(rows[start : start + size])
+def run_many(
+    plans: Sequence[tuple[Plan, Path]],
+    executor: Executor,
+    resume: bool = False,
+    file_format: str = "parquet",
+    chunk_size: int = 50,
+) -> list[tuple[pd.DataFrame, int]]:
+    """Run every plan into its file at once, one pool for all.
+
+    Returns, per plan, its table and the number of cells computed now.
+
+    Raises
+    ------
+    InvalidProblem
+        For an output that holds results without ``resume``, before any cell is computed.
+    """
+    stores, tasks, owner = [], [], []
+    for number, (plan, out) in enumerate(plans):
+        store = Store(out, file_format)
+        finished = store.done()
+        if len(finished) and not resume:
+            raise InvalidProblem(f"{out} already holds results: give --resume or another --out")
+        done = set(finished["key"]) if len(finished) else set()
+        for index, job in enumerate(plan.jobs):
+            if job.key not in done:
+                tasks.append(Task(index, job, plan.name, plan.checks, plan.settings, plan.measures))
+                owner.append(number)
+        stores.append(store)
+    total = sum(len(plan.jobs) for plan, _ in plans)
+    progress = Progress(total, total - len(tasks))
+    buffers: list[list[dict]] = [[] for _ in plans]
+    try:
+        for position, row in executor.run(tasks):
+            buffer = buffers[owner[position]]
+            buffer.append(row)
+            progress.update(row)
+            if len(buffer) >= chunk_size:
+                stores[owner[position]].write_chunk(buffer)
+                buffer.clear()
+    finally:
+        progress.close()
+        for store, buffer in zip(stores, buffers, strict=True):
+            if buffer:
+                store.write_chunk(buffer)
+    computed = [owner.count(number) for number in range(len(plans))]
+    return [
+        (store.finish(len(plan.jobs)), count)
+        for store, (plan, _), count in zip(stores, plans, computed, strict=True)
+    ]
+
+
+def collect(plan: Plan, executor: Executor) -> pd.DataFrame:
+    """Every record of ``plan``, in cell order, computed by ``executor`` (no file written)."""
+    tasks = [
+        Task(index, job, plan.name, plan.checks, plan.settings, plan.measures)
+        for index, job in enumerate(plan.jobs)
+    ]
+    rows = [row for _, row in executor.run(tasks)]
+    return pd.DataFrame(sorted(rows, key=lambda row: row["index"]))
 
 
 def run(
-    spec: RunSpec,
+    plan: Plan,
     out: Path,
     executor: str = "serial",
     address: str | None = None,
@@ -171,99 +386,16 @@ def run(
     file_format: str = "parquet",
     chunk_size: int = 50,
     workers: int | None = None,
+    budget_s: float = BUDGET_S,
 ) -> tuple[pd.DataFrame, int]:
-    """Run ``spec`` and write its table to ``out``; return the table and the rows computed.
+    """Run ``plan`` and write its table to ``out``; return the table and the cells computed.
 
     Raises
     ------
     InvalidProblem
-        For a bad specification, an unknown executor, an output that exists without
-        ``resume``, or an unreachable Dask address: all before any row is computed.
+        For an unknown executor, an output that exists without ``resume``, or an unreachable
+        Dask address: all before any cell is computed.
     """
-    if executor not in EXECUTORS:
-        raise InvalidProblem(f"executor {executor!r}: must be one of {', '.join(EXECUTORS)}")
-    rows = spec.rows()
-    store = Store(out, file_format)
-    finished = store.done()
-    if len(finished) and not resume:
-        raise InvalidProblem(f"{out} already holds results: give --resume or another --out")
-    done_keys = set(finished["key"]) if len(finished) else set()
-    todo = [row for row in rows if row.key not in done_keys]
-    settings = {"continuity_sizes": list(spec.continuity_sizes)}
-    chunks = list(_chunks(todo, chunk_size))
-    first = len(list(store.parts.glob("part-*"))) if store.parts.exists() else 0
-    progress = Progress(len(rows))
-    progress.done = len(rows) - len(todo)
-    submit = _EXECUTE[executor]
-    try:
-        for number, records in enumerate(submit(chunks, spec.checks, settings, address, workers)):
-            store.write_chunk(records, first + number)
-            progress.update(records)
-    finally:
-        progress.close()
-    return store.finish(len(rows)), len(todo)
-
-
-Results = Iterable[list[dict]]
-
-
-def _serial(
-    chunks: list, checks: Sequence[str], settings: dict, address: Any, workers: Any
-) -> Results:
-    for chunk in chunks:
-        yield compute_chunk(chunk, checks, settings)
-
-
-def _processes(
-    chunks: list, checks: Sequence[str], settings: dict, address: Any, workers: Any
-) -> Results:
-    with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
-        futures = [pool.submit(compute_chunk, chunk, checks, settings) for chunk in chunks]
-        try:
-            for future in as_completed(futures):
-                yield future.result()
-        finally:
-            for future in futures:
-                future.cancel()
-
-
-def _dask(
-    chunks: list, checks: Sequence[str], settings: dict, address: Any, workers: Any
-) -> Results:
-    try:
-        from dask.distributed import Client, LocalCluster
-        from dask.distributed import as_completed as dask_completed
-    except ImportError:  # an optional dependency: say how to get it
-        raise InvalidProblem("the dask executor needs Dask: pip install 'lawbench[dask]'") from None
-
-    cluster = None
-    try:
-        if address:
-            client = Client(address, timeout="10s")
-        else:
-            cluster = LocalCluster(
-                n_workers=workers or os.cpu_count(),
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-            )
-            client = Client(cluster)
-    except OSError as exc:
-        raise InvalidProblem(f"dask scheduler {address!r} cannot be reached ({exc})") from None
-    try:
-        futures = [
-            client.submit(compute_chunk, chunk, checks, settings, pure=False) for chunk in chunks
-        ]
-        for future in dask_completed(futures):
-            yield future.result()
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
-
-
-_EXECUTE: dict[str, Callable[..., Results]] = {
-    "serial": _serial,
-    "processes": _processes,
-    "dask": _dask,
-}
+    pool = Executor(executor, workers, budget_s, address, chunk_size)
+    with pool:
+        return run_many([(plan, Path(out))], pool, resume, file_format, chunk_size)[0]

@@ -1,225 +1,156 @@
-"""Studies tabulated over one parameter: every law that can treat them, side by side.
+"""Study tables as a reader sees them: what ``lawbench study NAME`` prints and writes.
 
-A table is a tidy frame (one row per law and parameter value) and notes: the laws left out and
-why (not registered, or refusing the scene), and the rows a law failed, with the error class and
-message. A law's failure on one row never stops the table.
-
-- ``rocking_block``: the ratio of angular velocities ``omega+ / omega-`` of the rocking block
-  against Housner's ``1 - 3/2 sin^2(alpha)``, over aspect ratios width / height from 0.1 to 10
-  (9 log-spaced values), with ``e = 0`` (Housner's plastic impact), height 1 m, and two
-  frictions: ``mu = 0`` and ``mu = 1`` (the landing corner sticks in Housner's impact for
-  every aspect ratio: it needs ``mu >= 3 w h / (w^2 + 4 h^2) <= 3/4``). Every registered law
-  is tried.
-- ``sphere_wall``: the tangential behaviour of ``brach``, ``whittaker`` and ``darboux_keller``
-  for a sphere without pre-impact spin striking the wall at incidences 5 to 85 degrees (the
-  case's other defaults): the post-impact slip of the contact point along the pre-impact slip
-  direction ``s`` (negative: reversed), the spin about ``n x s`` (positive: rolling along ``s``;
-  rolling without slip is ``radius spin = vt``), and the impulse ratio ``-Pt.s / Pn``.
-- ``dispersion``: the share of the post-impact kinetic energy carried by each of three equal
-  balls struck by the first, and the dispersion index, for every law, as the stiffness ratio of
-  the two contacts goes from 1e-3 to 1e3 (rigid laws do not read it: their rows repeat).
+A study's table (`lawbench.runner.collect`) has one row per cell with every record column
+(`lawbench.record.Record`). The printed view keeps what the study varies and measures: the law
+(and scene, when it has several), each swept parameter as a typed column, the transform's
+value, the options swept, the measured columns (a mapping measure spread over one column per
+key) and the verdict, for every cell that gave an answer; the cells that did not are notes,
+one per law and reason, each with the count of its cells.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
-from lawbench.api import evaluate
-from lawbench.case import CASES
-from lawbench.checks import Trial
-from lawbench.errors import InvalidProblem, NotApplicable
-from lawbench.law import LAWS
-
-ASPECT_RATIOS = np.logspace(-1.0, 1.0, 9)
-ROCKING_FRICTIONS = (0.0, 1.0)
-INCIDENCES = np.linspace(5.0, 85.0, 9)
-SPHERE_LAWS = ("brach", "whittaker", "darboux_keller")
-DISPERSION_RATIOS = np.logspace(-3.0, 3.0, 7)
-
-# A row of a study: its label columns and the case parameters it sets.
-Row = tuple[dict[str, Any], dict[str, Any]]
+from lawbench.errors import InvalidProblem
+from lawbench.guard import BUDGET_S
+from lawbench.record import budget_text
+from lawbench.runner import Executor, collect
+from lawbench.study import STUDIES, Study
+from lawbench.transforms import parse
 
 
 @dataclass
 class Table:
-    """A tabulated study: the frame and the notes (laws left out, rows that failed)."""
+    """A study and its table: the full records (``data``) and the view of them."""
 
-    name: str
-    title: str
-    frame: pd.DataFrame
-    notes: list[str] = field(default_factory=list)
+    study: Study
+    data: pd.DataFrame
+
+    @property
+    def frame(self) -> pd.DataFrame:
+        """The answered cells: what varies, what is measured, and the verdict."""
+        data = self.data
+        if data.empty or "error_class" not in data:
+            return pd.DataFrame()
+        answered = data[data["error_class"].fillna("") == ""]
+        columns: dict[str, Any] = {"law": answered["law"]}
+        if len(set(data["case"])) > 1:
+            columns["case"] = answered["case"]
+        for name in self.study.grid:
+            columns[name] = [_plain(json.loads(p).get(name)) for p in answered["params"]]
+        if self.study.transform:
+            columns[self.study.transform] = [parse(t)[1] for t in answered["transform"]]
+        for name in _varied_options(answered["options"]):
+            columns[name] = [json.loads(o).get(name) for o in answered["options"]]
+        for name in self.study.measures:
+            columns.update(_spread(name, answered[name]))
+        columns["verdict"] = answered["verdict"]
+        return pd.DataFrame(columns).reset_index(drop=True)
+
+    @property
+    def notes(self) -> list[str]:
+        """One line per law and reason for the cells that gave no answer, with their count."""
+        data = self.data
+        if data.empty or "error_class" not in data:
+            return []
+        failed = data[data["error_class"].fillna("") != ""]
+        notes = []
+        for (law, verdict, message), group in failed.groupby(
+            ["law", "verdict", "error_message"], sort=False
+        ):
+            total = int((data["law"] == law).sum())
+            first = group.iloc[0]
+            budget = budget_text(first.to_dict())
+            where = f"{len(group)} of {total} cells, first: `{first['reproducer']}`"
+            notes.append(
+                f"{law}: {verdict} on {where}: {first['error_class']}: {message}"
+                + (f" ({budget})" if budget else "")
+            )
+        return notes
 
     def text(self) -> str:
-        """The table as aligned text, its title first and its notes last."""
-        body = self.frame.to_string(index=False, float_format=lambda x: f"{x:.6g}")
-        notes = [f"note: {note}" for note in self.notes]
-        return "\n".join([self.title, "", body if len(self.frame) else "(no rows)", *notes])
+        """The view as aligned text, the study's title first and its notes last."""
+        frame = self.frame
+        body = frame.to_string(index=False, float_format=lambda x: f"{x:.6g}")
+        lines = [f"{self.study.name}: {self.study.title}", ""]
+        lines.append(body if len(frame) else "(no cell gave an answer)")
+        return "\n".join([*lines, *(f"note: {note}" for note in self.notes)])
 
-    def write_csv(self, path: Path) -> Path:
-        """Write the frame to ``path`` as CSV (parent folders created); return the path."""
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self.frame.to_csv(path, index=False)
+    def write(self, path: Path) -> Path:
+        """Write the full table to ``path`` (Parquet for ``.parquet``, else CSV); return it.
+
+        Raises
+        ------
+        InvalidProblem
+            When the file cannot be written.
+        """
+        path = Path(path)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if path.suffix == ".parquet":
+                self.data.to_parquet(path, index=False)
+            else:
+                self.data.to_csv(path, index=False)
+        except OSError as exc:
+            raise InvalidProblem(f"--out {path}: cannot write ({exc.strerror})") from None
         return path
 
 
-def _study(
-    case_name: str,
-    laws: Iterable[str],
-    rows: list[Row],
-    measure: Callable[[Trial], dict[str, float]],
-) -> tuple[list[dict[str, Any]], list[str]]:
-    """Solve every row with every law; return the table rows and the notes."""
-    case, records, notes = CASES.get(case_name), [], []
-    for name in laws:
-        if name not in LAWS:
-            notes.append(f"{name}: left out, not registered")
-            continue
-        refusals: dict[str, list[str]] = {}
-        failures: list[str] = []
-        for labels, params in rows:
-            try:
-                values = measure(evaluate(name, case, **params))
-            except NotApplicable as exc:
-                refusals.setdefault(str(exc), []).append(_labels(labels))
-                continue
-            except Exception as exc:  # a row records its error, the table goes on
-                failures.append(f"{_labels(labels)}: {type(exc).__name__}: {exc}")
-                continue
-            if not np.isfinite(list(values.values())).all():
-                failures.append(f"{_labels(labels)}: non-finite value {values}")
-                continue
-            records.append({"law": name, **labels, **values})
-        if not any(record["law"] == name for record in records):
-            reason = next(iter(refusals), None) or failures[0]
-            notes.append(f"{name}: left out, no row solved ({reason})")
-            continue
-        notes += [
-            f"{name}: refused on {len(where)} of {len(rows)} rows (from {where[0]}): {reason}"
-            for reason, where in refusals.items()
-        ]
-        notes += [f"{name}: failed at {failure}" for failure in failures]
-    return records, notes
+def _plain(value: Any) -> Any:
+    """A parameter value for a table column: a list of one number as the number."""
+    return value[0] if isinstance(value, list) and len(value) == 1 else value
 
 
-def _labels(labels: dict[str, Any]) -> str:
-    return ", ".join(f"{key} = {value:.4g}" for key, value in labels.items())
+def _varied_options(options: pd.Series) -> list[str]:
+    parsed = [json.loads(o) for o in options]
+    names = dict.fromkeys(name for o in parsed for name in o)
+    return [n for n in names if len({json.dumps(o.get(n)) for o in parsed}) > 1]
 
 
-def rocking_block_table() -> Table:
-    """Every registered law's ``omega+ / omega-`` on the rocking block against Housner's."""
-    from lawbench.cases.rocking_block import housner_ratio
-
-    rows = [
-        (
-            {"mu": mu, "width_over_height": float(aspect)},
-            {"width": float(aspect), "height": 1.0, "e": 0.0, "mu": mu},
-        )
-        for mu in ROCKING_FRICTIONS
-        for aspect in ASPECT_RATIOS
-    ]
-
-    def measure(trial: Trial) -> dict[str, float]:
-        ratio = trial.outcome.v_plus[2] / trial.problem.v[2]
-        housner = housner_ratio(trial.params["width"], trial.params["height"])
-        return {"omega_ratio": ratio, "housner": housner, "difference": ratio - housner}
-
-    records, notes = _study("rocking_block", LAWS.names(), rows, measure)
-    columns = ["law", "mu", "width_over_height", "omega_ratio", "housner", "difference"]
-    title = (
-        "rocking block: omega+/omega- against Housner's 1 - 3/2 sin^2(alpha), e = 0, "
-        "height 1 m, width = height x width_over_height; Housner's formula holds for "
-        "width_over_height <= sqrt(2) (wider, the pivot cannot lift off)"
-    )
-    return Table("rocking_block", title, pd.DataFrame(records, columns=columns), notes)
+def _spread(name: str, values: pd.Series) -> dict[str, list[Any]]:
+    """A measure's column, or one column per key when the measure is a mapping."""
+    parsed = [json.loads(v) if isinstance(v, str) else v for v in values]
+    if parsed and all(isinstance(v, dict) for v in parsed):
+        keys = dict.fromkeys(k for v in parsed for k in v)
+        return {f"{name}[{k}]": [v.get(k) for v in parsed] for k in keys}
+    return {name: parsed}
 
 
-def sphere_wall_table() -> Table:
-    """Tangential behaviour of the one-contact frictional laws on the sphere over incidence."""
-    from lawbench.cases.sphere_wall import NORMAL, TANGENTS
-
-    rows = [
-        ({"angle_deg": float(angle)}, {"angle": float(angle), "spin": [0.0, 0.0, 0.0]})
-        for angle in INCIDENCES
-    ]
-
-    def measure(trial: Trial) -> dict[str, float]:
-        problem, outcome = trial.problem, trial.outcome
-        slip = problem.ut / np.linalg.norm(problem.ut)
-        axis = np.cross(NORMAL, slip[0] * TANGENTS[0] + slip[1] * TANGENTS[1])
-        return {
-            "ut_minus": float(np.linalg.norm(problem.ut)),
-            "ut_plus": float(problem.Wt.T @ outcome.v_plus @ slip),
-            "spin_plus": float(outcome.v_plus[3:] @ axis),
-            "impulse_ratio": float(-outcome.Pt @ slip / outcome.Pn[0]),
-        }
-
-    records, notes = _study("sphere_wall", SPHERE_LAWS, rows, measure)
-    columns = ["law", "angle_deg", "ut_minus", "ut_plus", "spin_plus", "impulse_ratio"]
-    case = CASES.get("sphere_wall").parameters()
-    title = (
-        "sphere on a wall, no pre-impact spin: post-impact slip ut_plus along the pre-impact "
-        "slip, spin about n x s, impulse ratio -Pt.s/Pn; "
-        f"e = {case['e']:g}, e_t = {case['e_t']:g}, mu = {case['mu']:g}, "
-        f"speed = {case['speed']:g} m/s, radius = {case['radius']:g} m"
-    )
-    return Table("sphere_wall", title, pd.DataFrame(records, columns=columns), notes)
-
-
-def dispersion_table() -> Table:
-    """Energy shares per ball on three equal balls struck by the first, as stiffness varies."""
-    from lawbench.checks.dispersion import dispersion_index
-    from lawbench.mechanics import energy_shares
-
-    rows = [
-        ({"stiffness_ratio": float(ratio)}, {"stiffness_ratio": float(ratio)})
-        for ratio in DISPERSION_RATIOS
-    ]
-
-    def measure(trial: Trial) -> dict[str, float]:
-        shares = energy_shares(trial.problem, trial.outcome.v_plus)
-        return {
-            **{f"share_{b}".replace(" ", "_"): s for b, s in shares.items()},
-            "dispersion_index": dispersion_index(shares),
-        }
-
-    records, notes = _study("three_ball_chain", LAWS.names(), rows, measure)
-    columns = [
-        "law",
-        "stiffness_ratio",
-        "share_ball_1",
-        "share_ball_2",
-        "share_ball_3",
-        "dispersion_index",
-    ]
-    title = (
-        "three equal balls, velocities (1, 0, 0), e = 1, Hertz contacts: share of the "
-        "post-impact kinetic energy per ball and the dispersion index (0: all in one ball) as "
-        "the stiffness of contact 1 over contact 0 goes from 1e-3 to 1e3"
-    )
-    return Table("dispersion", title, pd.DataFrame(records, columns=columns), notes)
-
-
-TABLES: dict[str, Callable[[], Table]] = {
-    "rocking_block": rocking_block_table,
-    "sphere_wall": sphere_wall_table,
-    "dispersion": dispersion_table,
-}
-
-
-def build_table(name: str) -> Table:
-    """Build the table called ``name``.
+def study_table(
+    name: str,
+    given: dict[str, str] | None = None,
+    executor: str = "serial",
+    workers: int | None = None,
+    budget_s: float = BUDGET_S,
+) -> Table:
+    """Run the study called ``name`` (with the parameters ``given`` fixed) and tabulate it.
 
     Raises
     ------
     InvalidProblem
-        For an unknown name; the message lists the known ones.
+        For an unknown study, a parameter none of its scenes has, or a bad value.
     """
-    if name not in TABLES:
-        raise InvalidProblem(f"unknown table {name!r}; known: {', '.join(TABLES)}")
-    return TABLES[name]()
+    study = STUDIES.get(name)
+    if given:
+        study = study.with_params(_coerced(study, given))
+    with Executor(executor, workers, budget_s) as pool:
+        return Table(study, collect(study.plan(), pool))
+
+
+def _coerced(study: Study, given: dict[str, str]) -> dict[str, Any]:
+    """The values of ``given`` as the study's first scene that has each parameter reads them."""
+    from lawbench.case import CASES
+
+    values = {}
+    for key, text in given.items():
+        specs = [s for c in study.case_names() for s in CASES.get(c).params if s.name == key]
+        if not specs:
+            raise InvalidProblem(f"--set {key}: no scene of study {study.name!r} has it")
+        values[key] = specs[0].coerce(text)
+    return values

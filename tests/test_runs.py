@@ -1,4 +1,7 @@
-"""Run specifications, executors, chunked results and resuming."""
+"""Run specifications, the executor and its guard, records, transforms, chunks and resuming."""
+
+import math
+import time
 
 import numpy as np
 import pandas as pd
@@ -6,7 +9,11 @@ import pytest
 
 import lawbench
 from lawbench.grid import RunSpec, values
-from lawbench.runner import run
+from lawbench.guard import Guard
+from lawbench.record import budget_text
+from lawbench.runner import Executor, Task, compute, run, run_many
+from lawbench.study import Job, Plan
+from lawbench.transforms import apply, parse, spell
 
 SPEC = {
     "seed": 3,
@@ -71,13 +78,14 @@ def test_malformed_toml_is_refused(tmp_path):
 
 
 def without_time(table):
-    return table.drop(columns="wall_time_s").reset_index(drop=True)
+    return table.drop(columns=["wall_time_s", "spent_s"]).reset_index(drop=True)
 
 
 def test_serial_processes_and_dask_give_the_same_table(tmp_path):
     spec = RunSpec.from_dict(SPEC)
+    plan = spec.plan()
     tables = {
-        executor: run(spec, tmp_path / f"{executor}.parquet", executor=executor, workers=2)[0]
+        executor: run(plan, tmp_path / f"{executor}.parquet", executor=executor, workers=2)[0]
         for executor in ("serial", "processes", "dask")
     }
     assert len(tables["serial"]) == len(spec.rows())
@@ -100,7 +108,7 @@ def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
             ]
         }
     )
-    table, computed = run(spec, tmp_path / "out.csv", file_format="csv")
+    table, computed = run(spec.plan(), tmp_path / "out.csv", file_format="csv")
     assert computed == 2
     assert list(table["error_class"].fillna("")) == ["BudgetExceeded", ""]
     assert list(table["verdict"]) == ["budget", "holds"]
@@ -110,11 +118,151 @@ def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
 def test_resume_computes_only_what_is_missing(tmp_path):
     spec = RunSpec.from_dict(SPEC)
     out = tmp_path / "out.parquet"
-    full, _ = run(spec, tmp_path / "reference.parquet")
+    full, _ = run(spec.plan(), tmp_path / "reference.parquet")
     partial = RunSpec.from_dict({**SPEC, "grid": SPEC["grid"][:1]})
-    run(partial, out, chunk_size=7)
+    run(partial.plan(), out, chunk_size=7)
     with pytest.raises(lawbench.InvalidProblem, match="--resume"):
-        run(spec, out)
-    table, computed = run(spec, out, resume=True)
+        run(spec.plan(), out)
+    table, computed = run(spec.plan(), out, resume=True)
     assert computed == len(spec.rows()) - len(partial.rows())
     pd.testing.assert_frame_equal(without_time(table), without_time(full))
+
+
+# The per-job guard, in every executor.
+
+SLOW = Job("lzb", "ball_chain", {"n": 100, "e": [0.0]})
+
+
+def test_the_guard_returns_answers_and_errors_and_stops_a_task_over_its_budget():
+    with Guard(workers=1, budget_s=30.0) as guard:
+        slow = guard.submit(time.sleep, 60, budget=2.0)
+        failing = guard.submit(math.sqrt, -1.0)
+        fine = guard.submit(math.sqrt, 4.0)
+        start = time.monotonic()
+        assert guard.result(slow).status == "time-out"
+        assert time.monotonic() - start < 20
+        error = guard.result(failing)
+        assert (error.status, error.error_class) == ("error", "ValueError")
+        assert guard.result(fine).value == 2.0
+
+
+@pytest.mark.parametrize("executor", ["serial", "processes"])
+def test_a_cell_stopped_by_the_guard_is_a_budget_cell_naming_it(tmp_path, executor):
+    plan = Plan("slow", [SLOW, Job("newton", "ball_chain")])
+    start = time.monotonic()
+    table, _ = run(plan, tmp_path / "slow.csv", executor, file_format="csv", budget_s=2.0)
+    assert time.monotonic() - start < 30
+    stopped, answered = table.to_dict("records")
+    assert stopped["verdict"] == "budget" and answered["verdict"] == "holds"
+    assert (stopped["budget"], stopped["budget_amount"]) == ("wall-clock guard", 2.0)
+    assert stopped["exit_status"] == 4
+    assert stopped["reproducer"].endswith("--max-seconds 2")
+    assert budget_text(stopped).startswith("budget wall-clock guard = 2 s, after ")
+
+
+# Records: fixed fields for every cell.
+
+
+def test_every_record_has_the_same_fields_whatever_happened():
+    cells = [
+        Job("newton", "three_ball_chain"),  # answered
+        Job("brach", "three_ball_chain"),  # refused
+        Job("sequential", "two_balls_wall", {"e": [0.0]}, {"max_steps": 5}),  # budget
+        Job("newton", "three_ball_chain", {"e": [2.0]}),  # invalid input
+    ]
+    rows = [compute(Task(k, job, "", ("energy_gain",))) for k, job in enumerate(cells)]
+    fields = set(rows[0]) - {"energy_gain_value", "energy_gain_verdict"}
+    fields -= {"energy_gain_finding", "energy_gain_detail"}
+    for row in rows:
+        assert fields <= set(row)
+    assert [r["verdict"] for r in rows] == ["holds", "refused", "budget", "unexplained"]
+    assert [r["exit_status"] for r in rows] == [0, 3, 4, 2]
+    assert rows[2]["budget"] == "max_steps" and rows[2]["budget_amount"] == 5
+    assert rows[2]["spent_s"] >= 0
+    assert rows[0]["energy_gain_verdict"] == "holds"
+
+
+def test_a_cell_verdict_is_the_worst_of_its_checks():
+    separating = Job("newton", "three_ball_chain", {"velocities": [1.0, 0.0, 0.75]})
+    row = compute(Task(0, separating, "", ("energy_gain", "admissible", "friction_cone")))
+    assert row["admissible_verdict"] == "law property"
+    assert row["friction_cone_verdict"] == "refused"
+    assert row["verdict"] == "law property"
+    finding = lawbench.LAWS.get("newton").findings[row["admissible_finding"]]
+    assert finding.check == "admissible"
+
+
+# Transforms of the built problem.
+
+
+@pytest.mark.parametrize("case", ["three_ball_chain", "falling_rod", "sphere_wall"])
+def test_grazing_scales_every_gap_rate_and_keeps_what_the_contacts_do_not_see(case):
+    problem = lawbench.CASES.get(case).build()
+    made = apply("grazing=1e-09", problem)
+    fastest = -problem.un.min()
+    # Gap rates at rest stay at rest up to the rounding of the velocities they subtract.
+    rounding = 1e-15 * np.abs(problem.v).max()
+    np.testing.assert_allclose(made.un, problem.un * 1e-9 / fastest, rtol=1e-6, atol=rounding)
+    # The change is M^-1 Wn x: invisible to every w with Wn.T w = 0 in the kinetic metric.
+    _, _, vt = np.linalg.svd(problem.Wn.T)
+    hidden = vt[problem.m :]
+    np.testing.assert_allclose(hidden @ problem.M @ made.v, hidden @ problem.M @ problem.v)
+
+
+@pytest.mark.parametrize("law", ["newton", "moreau", "poisson"])
+def test_a_contact_given_twice_changes_no_outcome(law):
+    """The same constraint twice is the same set of admissible velocities.
+
+    Moreau's law projects on the tangent cone (Brogliato 2010, eqs. 16-17), Newton's solves
+    ``Wn.T v+ = -e Wn.T v-``, Poisson's two complementarity problems: none of these sets
+    changes when a column of Wn is repeated, so the post-impact velocity stays.
+    """
+    problem = lawbench.CASES.get("three_ball_chain").build(e=[0.5])
+    twice = apply("duplicated", problem)
+    assert twice.m == problem.m + 1
+    solver = lawbench.LAWS.get(law)
+    once, again = solver.resolve(problem), solver.resolve(twice)
+    np.testing.assert_allclose(again.v_plus, once.v_plus, atol=1e-9)
+    np.testing.assert_allclose(again.Pn[0] + again.Pn[-1], once.Pn[0], atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("spelling", "message"),
+    [("spin=2", "unknown transform 'spin'"), ("grazing", "give a value"), ("grazing=x", "x")],
+)
+def test_a_bad_transform_is_refused(spelling, message):
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        parse(spelling)
+
+
+def test_a_transformed_cell_spells_its_transform_exactly():
+    job = Job("newton", "three_ball_chain", {"e": [1.0]}, transform=spell("grazing", 1e-8 / 3))
+    assert parse(job.transform)[1] == 1e-8 / 3
+    assert job.command() == (
+        f"lawbench solve newton three_ball_chain --set e=1.0 --transform grazing={1e-8 / 3!r}"
+    )
+    assert job.key != Job("newton", "three_ball_chain", {"e": [1.0]}).key
+
+
+def test_a_grid_can_transform_its_rows():
+    grid = {"laws": ["newton"], "cases": ["three_ball_chain"], "transforms": ["duplicated"]}
+    spec = RunSpec.from_dict({"grid": [grid]})
+    (job,) = spec.rows()
+    assert job.transform == "duplicated"
+    assert compute(Task(0, job, "", ("momentum",)))["momentum_verdict"] == "holds"
+
+
+@pytest.mark.parametrize("executor", ["processes", "dask"])
+def test_several_plans_through_one_pool_keep_their_cells_apart(tmp_path, executor):
+    """Every plan's cells are numbered from 0: the pool must not mix them up."""
+    plans = [
+        Plan("one", [Job("newton", "three_ball_chain", {"e": [e]}) for e in (0.0, 0.5, 1.0)]),
+        Plan("two", [Job("poisson", "two_balls_wall", {"e": [e]}) for e in (0.2, 0.4)]),
+    ]
+    outs = [(plan, tmp_path / f"{plan.name}.parquet") for plan in plans]
+    with Executor(executor, workers=2, chunk_size=2) as pool:
+        results = run_many(outs, pool)
+    for plan, (table, computed) in zip(plans, results, strict=True):
+        assert computed == len(plan.jobs)
+        assert list(table["study"]) == [plan.name] * len(plan.jobs)
+        assert list(table["key"]) == [job.key for job in plan.jobs]

@@ -1,11 +1,12 @@
-"""The tabulated studies and ``lawbench table``: rows, columns, no NaN, failures noted."""
+"""Studies declared beside their scenes and laws, and ``lawbench study`` (alias ``table``)."""
 
 from __future__ import annotations
 
+import ast
 import math
 import subprocess
 import sys
-from typing import Any, ClassVar
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -13,20 +14,45 @@ import pytest
 from lawbench.cases.rocking_block import housner_ratio
 
 import lawbench
-from lawbench import tables
-from lawbench.errors import SolverFailure
-from lawbench.law import Law
-from lawbench.tags import Tags
+from lawbench.study import STUDIES, Study
+from lawbench.tables import Table, study_table
+from lawbench.verdicts import Verdict
 
 
 @pytest.fixture(scope="module")
 def rocking():
-    return tables.build_table("rocking_block")
+    return study_table("rocking_block")
 
 
 @pytest.fixture(scope="module")
 def sphere():
-    return tables.build_table("sphere_wall")
+    return study_table("sphere_wall")
+
+
+def lawbench_command(*args):
+    return subprocess.run(
+        [sys.executable, "-m", "lawbench", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+
+
+def test_every_declared_study_expands_into_valid_cells():
+    """Every study's grid is checked against its scenes and laws (an error names the study)."""
+    names = STUDIES.names()
+    assert {"rocking_block", "sphere_wall", "dispersion", "summary"} <= set(names)
+    for study in STUDIES:
+        for mode in ("quick", "full"):
+            jobs = list(study.preset(mode).jobs())
+            assert jobs, study.name
+            assert len({job.key for job in jobs}) == len(jobs), study.name
+
+
+def test_study_cells_are_deterministic():
+    study = STUDIES.get("three_ball_chain_grazing")
+    assert list(study.jobs()) == list(study.jobs())
 
 
 def test_rocking_block_table_has_every_law_at_nine_aspect_ratios(rocking):
@@ -34,55 +60,56 @@ def test_rocking_block_table_has_every_law_at_nine_aspect_ratios(rocking):
     assert list(frame.columns) == [
         "law",
         "mu",
-        "width_over_height",
+        "width",
         "omega_ratio",
         "housner",
         "difference",
+        "verdict",
     ]
     assert not frame.isna().any().any()
-    assert set(frame["mu"]) <= {0.0, 1.0}
+    assert set(frame["mu"]) == {0.0, 1.0}
     for (_, _), group in frame.groupby(["law", "mu"]):
-        np.testing.assert_allclose(group["width_over_height"], np.logspace(-1, 1, 9))
+        np.testing.assert_allclose(group["width"], np.logspace(-1, 1, 9))
     present = set(frame["law"])
     for law in lawbench.LAWS.names():
-        assert law in present or any(note.startswith(f"{law}: left out") for note in rocking.notes)
-    np.testing.assert_allclose(
-        frame["housner"], [housner_ratio(a, 1.0) for a in frame["width_over_height"]]
-    )
+        assert law in present or any(note.startswith(f"{law}: refused") for note in rocking.notes)
+    np.testing.assert_allclose(frame["housner"], [housner_ratio(w, 1.0) for w in frame["width"]])
 
 
-def test_a_law_that_cannot_treat_two_contacts_is_left_out_with_the_reason(rocking):
+def test_every_cell_has_a_verdict_of_the_taxonomy(rocking):
+    assert len(rocking.data) == 2 * 9 * len(lawbench.LAWS.names())
+    assert set(rocking.data["verdict"]) <= {str(v) for v in Verdict}
+
+
+def test_a_law_that_cannot_treat_two_contacts_is_refused_with_the_reason(rocking):
     note = next(n for n in rocking.notes if n.startswith("brach:"))
-    assert "left out" in note and "2 closed contacts" in note
+    assert "refused on 18 of 18 cells" in note and "2 closed contacts" in note
     assert "brach" not in set(rocking.frame["law"])
 
 
 def test_sticking_laws_reproduce_housner_where_it_holds(rocking):
     """Housner 1963: e = 0, mu = 1 sticks; the pivot lifts off while width <= sqrt(2) height."""
     frame = rocking.frame
-    rows = frame[(frame["mu"] == 1.0) & (frame["width_over_height"] <= math.sqrt(2))]
+    rows = frame[(frame["mu"] == 1.0) & (frame["width"] <= math.sqrt(2))]
     for law in {"moreau", "whittaker"} & set(rows["law"]):
         np.testing.assert_allclose(rows[rows["law"] == law]["difference"], 0.0, atol=1e-9)
 
 
-def test_sphere_table_has_the_three_laws_or_their_reasons(sphere):
+def test_sphere_table_has_the_three_laws(sphere):
     frame = sphere.frame
     assert list(frame.columns) == [
         "law",
-        "angle_deg",
+        "angle",
         "ut_minus",
         "ut_plus",
         "spin_plus",
         "impulse_ratio",
+        "verdict",
     ]
     assert not frame.isna().any().any()
-    for law in tables.SPHERE_LAWS:
-        rows = frame[frame["law"] == law]
-        if len(rows):
-            np.testing.assert_allclose(rows["angle_deg"], np.linspace(5, 85, 9))
-        else:
-            assert any(note.startswith(f"{law}: left out") for note in sphere.notes)
-    assert "brach" in set(frame["law"])
+    assert list(dict.fromkeys(frame["law"])) == ["brach", "whittaker", "darboux_keller"]
+    for _, rows in frame.groupby("law"):
+        np.testing.assert_allclose(rows["angle"], np.linspace(5, 85, 9))
 
 
 def test_sphere_table_brach_rows_follow_equation_11(sphere):
@@ -93,83 +120,100 @@ def test_sphere_table_brach_rows_follow_equation_11(sphere):
     critical = math.degrees(math.atan(3.5 * mu * (1 + e) / (1 + e_t)))
     rows = sphere.frame[sphere.frame["law"] == "brach"]
     for row in rows.itertuples():
-        if row.angle_deg < critical:
+        if row.angle < critical:
             assert row.ut_plus == pytest.approx(-e_t * row.ut_minus, abs=1e-12)
             assert row.impulse_ratio < mu
         else:
             assert row.impulse_ratio == pytest.approx(mu, rel=1e-12)
-        vt = params["speed"] * math.sin(math.radians(row.angle_deg))
+        vt = params["speed"] * math.sin(math.radians(row.angle))
+        normal = (1 + e) * params["speed"] * math.cos(math.radians(row.angle))
         centre = row.ut_plus + radius * row.spin_plus  # tangential velocity of the centre
-        assert centre == pytest.approx(vt - row.impulse_ratio * _normal_impulse(params, row))
+        assert centre == pytest.approx(vt - row.impulse_ratio * normal)
 
 
-def _normal_impulse(params: dict[str, Any], row: Any) -> float:
-    """Pn / m of eq. (11): (1 + e) times the approach speed."""
-    return (1 + params["e"]) * params["speed"] * math.cos(math.radians(row.angle_deg))
+def test_a_mapping_measure_is_spread_over_one_column_per_key():
+    table = study_table("dispersion", {"stiffness_ratio": "1"})
+    frame = table.frame
+    shares = ["energy_shares[ball 1]", "energy_shares[ball 2]", "energy_shares[ball 3]"]
+    assert [*shares, "dispersion_index", "verdict"] == list(frame.columns[-5:])
+    np.testing.assert_allclose(frame[shares].sum(axis=1), 1.0)
+    sequential = frame[frame["law"] == "sequential"].iloc[0]
+    assert sequential["energy_shares[ball 3]"] == pytest.approx(1.0)
 
 
-class _Flaky(Law):
-    """A law that fails on some rows, to check that a table goes on."""
-
-    name = "flaky"
-    summary = "fails above 40 degrees"
-    source = "none"
-    tags = Tags(friction=True, spatial=True)
-    findings: ClassVar[dict] = {}
-
-    def _resolve(self, problem, options):
-        incidence = math.degrees(math.atan2(problem.v[0], -problem.v[1]))
-        if incidence > 60:
-            raise RuntimeError("a bug")
-        if incidence > 40:
-            raise SolverFailure("flaky: no convergence")
-        return lawbench.LAWS.get("brach")._resolve(problem, options)
-
-
-def test_a_failing_row_is_noted_and_the_table_goes_on(monkeypatch):
-    monkeypatch.setitem(lawbench.LAWS._entries, "flaky", _Flaky())
-    monkeypatch.setattr(tables, "SPHERE_LAWS", ("flaky", "not_a_law", "brach"))
-    table = tables.sphere_wall_table()
-    flaky = table.frame[table.frame["law"] == "flaky"]
-    np.testing.assert_allclose(flaky["angle_deg"], [5, 15, 25, 35])
-    assert len(table.frame[table.frame["law"] == "brach"]) == 9
-    failures = [note for note in table.notes if note.startswith("flaky: failed")]
-    assert len(failures) == 5
-    assert any("SolverFailure" in note for note in failures)
-    assert any("RuntimeError: a bug" in note for note in failures)
-    assert "not_a_law: left out, not registered" in table.notes
-
-
-def test_an_unknown_table_is_refused():
-    with pytest.raises(lawbench.InvalidProblem, match="unknown table 'nope'"):
-        tables.build_table("nope")
-
-
-def test_the_command_writes_the_csv_and_prints_the_table(tmp_path):
-    out = tmp_path / "sub" / "sphere.csv"
-    result = subprocess.run(
-        [sys.executable, "-m", "lawbench", "table", "sphere_wall", "--out", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
+def test_failed_cells_are_notes_once_per_law_and_reason():
+    study = Study(
+        "budgets",
+        "sequential with a tiny impact budget",
+        cases=("two_balls_wall",),
+        laws=("sequential",),
+        grid={"e": [[0.0], [0.5], [0.0, 0.5]]},
+        options={"sequential": {"max_steps": [5]}},
     )
+    from lawbench.runner import Executor, collect
+
+    with Executor() as pool:
+        table = Table(study, collect(study.plan(), pool))
+    assert list(table.data["verdict"]) == ["budget", "holds", "budget"]
+    (note,) = table.notes
+    assert note.startswith("sequential: budget on 2 of 3 cells, first: `lawbench solve ")
+    assert "(budget max_steps = 5, after " in note
+    assert len(table.frame) == 1
+
+
+def test_an_unknown_study_or_parameter_is_refused():
+    with pytest.raises(lawbench.InvalidProblem, match="unknown study 'nope'"):
+        study_table("nope")
+    with pytest.raises(lawbench.InvalidProblem, match="--set colour: no scene"):
+        study_table("sphere_wall", {"colour": "red"})
+
+
+def test_the_command_writes_the_table_and_prints_the_view(tmp_path):
+    out = tmp_path / "sub" / "sphere.csv"
+    result = lawbench_command("study", "sphere_wall", "--set", "angle=30", "--out", str(out))
     assert result.returncode == 0, result.stderr
     written = pd.read_csv(out)
-    expected = tables.build_table("sphere_wall").frame
-    assert list(written.columns) == list(expected.columns)
-    assert len(written) == len(expected)
-    np.testing.assert_allclose(written["ut_plus"], expected["ut_plus"], rtol=1e-12)
+    assert len(written) == 3 and set(written["verdict"]) == {"holds"}
+    assert {"reproducer", "exit_status", "ut_plus", "energy_gain_verdict"} <= set(written)
     assert "impulse_ratio" in result.stdout and str(out) in result.stdout
+    again = lawbench_command(*written["reproducer"][0].split()[1:], "--json")
+    assert again.returncode == int(written["exit_status"][0])
 
 
-def test_the_command_refuses_an_unknown_table_in_one_line():
-    result = subprocess.run(
-        [sys.executable, "-m", "lawbench", "table", "nope"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-    )
+def test_table_is_study_and_list_names_every_study():
+    listed = lawbench_command("study", "--list")
+    assert listed.returncode == 0, listed.stderr
+    for name in STUDIES.names():
+        assert f"  {name} " in listed.stdout, name
+    result = lawbench_command("table", "nope")
     assert result.returncode == 2
-    assert result.stderr.count("\n") == 1 and "unknown table 'nope'" in result.stderr
+    assert result.stderr.count("\n") == 1 and "unknown study 'nope'" in result.stderr
+
+
+ENGINE = ("study.py", "study_shapes.py", "runner.py", "record.py", "measures.py", "tables.py")
+ENGINE += ("transforms.py", "guard.py", "grid.py", "chains.py")
+
+
+def test_the_study_engine_and_the_report_name_no_law_or_scene():
+    """Studies, views and their shapes learn laws and scenes from the registries and from
+    the data declared with them; a name may appear in a docstring only."""
+    root = Path(lawbench.__file__).parent
+    names = set(lawbench.LAWS.names()) | set(lawbench.CASES.names())
+    paths = [root / name for name in ENGINE] + sorted((root / "report").glob("*.py"))
+    hits = []
+    for path in paths:
+        tree = ast.parse(path.read_text())
+        docs = {
+            id(node.body[0].value)
+            for node in ast.walk(tree)
+            if isinstance(getattr(node, "body", None), list)
+            and node.body
+            and isinstance(node.body[0], ast.Expr)
+            and isinstance(node.body[0].value, ast.Constant)
+        }
+        hits += [
+            f"{path.name}:{node.lineno} {node.value!r}"
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Constant) and node.value in names and id(node) not in docs
+        ]
+    assert not hits

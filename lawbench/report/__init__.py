@@ -1,10 +1,13 @@
 """The comparison report: every law on every scene, side by side, in seven sections.
 
-`write_report` writes a self-contained folder: ``index.html`` and ``report.md`` with the same
-content, every figure as PNG and SVG with the CSV of its data, every table as CSV. Sections:
-summary matrix of the checks with the findings, outcomes beside the references, speed versus
-accuracy, stability at the extremes, energy-increase maps, dispersion and continuity, and
-paths inside an impact. A law or scene that is missing or fails is reported, never a crash.
+`write_report` runs every registered study a section draws (`lawbench.study.Study.view`) and
+writes a self-contained folder: ``index.html`` and ``report.md`` with the same content, every
+figure as PNG and SVG with the CSV of its data, every table as CSV, every study's table in
+``runs/``. Sections, each a view of study tables: summary matrix of the checks with the
+findings, outcomes beside the ground truth and the references, speed versus accuracy (model
+error and numerical error), stability at the extremes, energy-increase maps, dispersion and
+continuity, and paths inside an impact. Every cell carries a verdict; the headline counts the
+unexplained ones. A law or scene that is missing or fails is reported, never a crash.
 """
 
 from __future__ import annotations
@@ -22,8 +25,8 @@ def write_report(out: Path, mode: str = "quick", config: Config | None = None) -
     out : Path
         The folder; created when missing, its report files replaced.
     mode : str
-        'quick' (small grids, a few minutes on two cores) or 'full' (the large grids, through
-        `lawbench.runner.run`, resumable from ``out/runs``).
+        'quick' (each study as declared, slow ones left out: a few minutes on two cores) or
+        'full' (each study's full sizes, slow ones in, resumable from ``out/runs``).
     config : Config, optional
         Settings replacing the preset of ``mode`` (a smaller grid for tests).
 

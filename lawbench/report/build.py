@@ -1,24 +1,28 @@
-"""Assemble the report: start every section's runs, then build the sections and the pages.
+"""Assemble the report: run every study the sections draw, then build the sections and pages.
 
-Every section first submits its work (so both workers stay busy across sections), then builds
-its tables and figures. A section that fails is kept in the report with its error.
+The studies run once, together, through one executor (`lawbench.report.runs.Context.run`); each
+section is then a view of their tables. The headline counts the *unexplained* cells of every
+table and lists each with the command that reproduces it. A section that fails is kept in the
+report with its error.
 """
 
 from __future__ import annotations
 
+import json
 import platform
 import time
 import traceback
-from collections.abc import Callable
-from functools import partial
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import matplotlib
 import numpy as np
+import pandas as pd
 import scipy
 
 import lawbench
+from lawbench.guard import Guard
 from lawbench.report import (
     dispersion,
     inside,
@@ -29,9 +33,9 @@ from lawbench.report import (
     tradeoff,
 )
 from lawbench.report.config import Config
-from lawbench.report.guard import Guard
-from lawbench.report.page import Figure, Section, save_figure, write_page
-from lawbench.report.runs import Context
+from lawbench.report.page import Figure, Section, Table, save_figure, write_page
+from lawbench.report.runs import Context, label
+from lawbench.verdicts import Verdict
 
 SECTIONS: tuple[ModuleType, ...] = (
     summary,
@@ -43,67 +47,103 @@ SECTIONS: tuple[ModuleType, ...] = (
     inside,
 )
 TITLE = "lawbench: impact laws compared"
+# Seconds to draw one figure in a worker.
+DRAWING_S = 300.0
 
 
-def _failed(module: ModuleType, exc: Exception) -> Callable[[], Section]:
-    where = traceback.extract_tb(exc.__traceback__)[-1]
-    text = (
-        f"This section failed: {type(exc).__name__}: {exc} "
-        f"(at {Path(where.filename).name}:{where.lineno})."
-    )
-    return lambda: Section(module.ANCHOR, module.TITLE, [text])
-
-
-def _finish(module: ModuleType, finish: Callable[[], Section]) -> Section:
+def _section(module: ModuleType, ctx: Context) -> Section:
     try:
-        return finish()
+        return module.build(ctx)
     except Exception as exc:  # the other sections are still worth writing
-        return _failed(module, exc)()
+        where = traceback.extract_tb(exc.__traceback__)[-1]
+        text = (
+            f"This section failed: {type(exc).__name__}: {exc} "
+            f"(at {Path(where.filename).name}:{where.lineno})."
+        )
+        return Section(module.ANCHOR, module.TITLE, [text])
 
 
 def build(out: Path, config: Config) -> Path:
-    """Run every section with ``config`` and write the report into ``out``."""
+    """Run every study the sections draw with ``config`` and write the report into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
-    runs = out / "runs"
-    if config.executor != "guard" and runs.is_dir():
-        # Finished grids of an earlier report are recomputed; interrupted ones resume.
-        for table in runs.glob("*.parquet"):
-            table.unlink()
     start = time.perf_counter()
-    with Guard(config.workers, config.budget_s) as guard:
-        ctx = Context(config, out, guard)
-        finishers = []
-        for module in SECTIONS:
-            try:
-                finishers.append((module, module.start(ctx)))
-            except Exception as exc:  # a section that cannot start is reported
-                finishers.append((module, _failed(module, exc)))
-        sections = [_finish(module, finish) for module, finish in finishers]
-        seconds = time.perf_counter() - start
-        preamble = _preamble(ctx, config, seconds)
-        write_page(out, TITLE, preamble, sections, ctx.rerun, partial(_save, guard))
+    ctx = Context(config, out)
+    ctx.run([view for module in SECTIONS for view in module.VIEWS])
+    sections = [_section(module, ctx) for module in SECTIONS]
+    seconds = time.perf_counter() - start
+    preamble = [*_preamble(ctx, config, seconds), *headline(ctx)]
+    write_page(out, TITLE, preamble, sections, ctx.rerun, _save(config))
     return out
 
 
-def _save(guard: Guard, figures: list[Figure], out: Path) -> None:
-    """Render the figures in the workers, both at once."""
-    handles = [guard.submit(save_figure, f.figure, f.name, f.data, out) for f in figures]
-    for figure, handle in zip(figures, handles, strict=True):
-        result = guard.result(handle)
-        if result.status != "ok":
-            reason = f"{result.error_class or result.status}: {result.error_message}"
-            raise RuntimeError(f"figure {figure.name} could not be written: {reason}")
+def _save(config: Config) -> Any:
+    def save(figures: list[Figure], out: Path) -> None:
+        """Draw the figures in worker processes, all at once."""
+        with Guard(config.workers, DRAWING_S) as guard:
+            handles = [guard.submit(save_figure, f.figure, f.name, f.data, out) for f in figures]
+            for figure, handle in zip(figures, handles, strict=True):
+                result = guard.result(handle)
+                if result.status != "ok":
+                    reason = f"{result.error_class or result.status}: {result.error_message}"
+                    raise RuntimeError(f"figure {figure.name} could not be written: {reason}")
+
+    return save
+
+
+def headline(ctx: Context) -> list[Any]:
+    """The count of *unexplained* cells over every study, and each with its reproducer."""
+    rows = []
+    for study, table in ctx.every_table():
+        table = table.fillna({"error_class": ""})
+        bad = table[(table["verdict"] == str(Verdict.UNEXPLAINED)) & (table["repeat"] == 0)]
+        checks = study.check_names()
+        for row in bad.to_dict("records"):
+            if row["error_class"]:
+                why = f"{row['error_class']}: {row['error_message']}"
+            else:
+                why = "; ".join(
+                    f"{c}: {row[f'{c}_detail']}"
+                    for c in checks
+                    if row[f"{c}_verdict"] == str(Verdict.UNEXPLAINED)
+                )
+            rows.append(
+                {
+                    "study": study.name,
+                    "law": row["law"],
+                    "scene": row["case"],
+                    "cell": label(json.loads(row["params"]), skip=()) or "defaults",
+                    "why": why,
+                    "reproducer": row["reproducer"],
+                    "exit status": row["exit_status"],
+                }
+            )
+    cells = sum(len(t) for _, t in ctx.every_table())
+    if not rows:
+        return [f"No unexplained cell among the {cells} cells of {len(ctx.studies)} studies."]
+    return [
+        f"{len(rows)} unexplained cells among the {cells} cells of {len(ctx.studies)} "
+        "studies: each is a bug to fix or a finding to write. Each is listed with a command "
+        "that reruns it and exits with the status shown (0 answered, 3 refused, 4 budget or "
+        "solver failure).",
+        Table(
+            "unexplained",
+            "Every unexplained cell of the report, with why and its reproducer.",
+            pd.DataFrame(rows),
+            commands=("reproducer",),
+        ),
+    ]
 
 
 def _preamble(ctx: Context, config: Config, seconds: float) -> list[str]:
     return [
         f"Mode `{config.mode}`: computed in {seconds:.0f} s (before drawing the figures) "
-        f"with {config.workers} worker processes (budget {config.budget_s:g} s per solve), "
-        f"executor `{config.executor}`. "
-        f"Rerun: `{ctx.rerun}`.",
+        f"with {config.workers} worker processes (executor `{config.executor}`; wall-clock "
+        f"guard {config.budget_s:g} s per cell). Rerun: `{ctx.rerun}`.",
         f"Laws: {', '.join(f'`{law.name}`' for law in ctx.laws) or 'none'}. "
-        f"Scenes: {', '.join(f'`{case.name}`' for case in ctx.cases) or 'none'}.",
+        f"Scenes: {', '.join(f'`{case.name}`' for case in ctx.cases) or 'none'}. "
+        f"Studies: {', '.join(f'`{s.name}`' for s in ctx.studies) or 'none'} "
+        "(`lawbench study NAME` runs one).",
         f"lawbench {lawbench.__version__}, Python {platform.python_version()}, numpy "
         f"{np.__version__}, scipy {scipy.__version__}, matplotlib {matplotlib.__version__}.",
-        *(f"Note: {note}." for note in ctx.notes),
+        *dict.fromkeys(f"Note: {note}." for note in ctx.notes),
     ]

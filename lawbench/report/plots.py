@@ -1,7 +1,8 @@
-"""Shared figure helpers: figures without pyplot, one colour and marker per law, log floors."""
+"""Shared figure helpers: figures without pyplot, law styles, log floors, coordinate units."""
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -10,6 +11,7 @@ from matplotlib.figure import Figure
 
 from lawbench.law import LAWS
 
+UNIT = re.compile(r"[\[(]([^\])]+)[\])]\s*$")
 # Exact zeros (an exact law against itself, no steps) are drawn at this floor on log axes.
 FLOOR = 1e-17
 MARKERS = "osD^v<>phP*X"
@@ -41,7 +43,15 @@ def floored(values: Any) -> np.ndarray:
     return np.where(np.isnan(array), np.nan, np.maximum(np.abs(array), FLOOR))
 
 
-def empty(axes: Any, text: str) -> None:
-    """Mark an axes that has nothing to show, with the reason."""
-    axes.text(0.5, 0.5, text, ha="center", va="center", wrap=True, transform=axes.transAxes)
-    axes.set_axis_off()
+def unit(coordinate: str) -> str:
+    """The unit a coordinate's name ends with (``"omega [rad/s]"`` -> ``"rad/s"``), or ''."""
+    found = UNIT.search(coordinate)
+    return found.group(1) if found else ""
+
+
+def by_unit(coordinates: list[str]) -> dict[str, list[int]]:
+    """Indices of the coordinates per unit, in order: quantities of one unit share an axis."""
+    groups: dict[str, list[int]] = {}
+    for k, name in enumerate(coordinates):
+        groups.setdefault(unit(name), []).append(k)
+    return groups

@@ -1,15 +1,17 @@
 """Section 4, stability at the extremes: a grid of verdicts per law.
 
-The cells and their verdicts are defined in `lawbench.report.extremes`. Cells on a scene's
-own parameters run as jobs (guarded workers in the quick mode, the runner in the full mode,
-where a solve over the budget counts as a time-out); grazing and duplicated-contact problems
-run in the guarded workers, killed at the budget. NaN, time-out and unexpected-error cells are
-listed with a command that reproduces them.
+A view of the studies declared with `lawbench.study_shapes.extremes`: each scene names the axes
+it is pushed along (stiffness and mass ratios over many decades, grazing approach speeds, long
+chains, large friction, a contact given twice), crossed with the values of its other swept
+parameters. Every cell's verdict is the worst of its checks' (`lawbench.checks`), or that of the
+error that stopped it (`lawbench.verdicts.of_error`): a cell stopped by the wall-clock guard is a
+*budget* cell, naming the guard and its seconds. Cells that are not *holds*, *law property* or
+*refused* are listed with the command that reproduces each.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import json
 from typing import Any
 
 import numpy as np
@@ -17,132 +19,115 @@ import pandas as pd
 from matplotlib.colors import to_rgb
 from matplotlib.patches import Patch
 
-from lawbench.report import plots, tasks
-from lawbench.report.extremes import CATEGORIES, TOLERANCE, UNACCEPTABLE, Cell, plan, verdict
-from lawbench.report.page import Figure, Section, Table
-from lawbench.report.runs import Context, Job, from_result
+from lawbench.report import plots
+from lawbench.report.marks import COLOURS, Mark
+from lawbench.report.page import Figure, Legend, Section, Table
+from lawbench.report.runs import Context, axis_value, label
+from lawbench.report.summary import failure
+from lawbench.study import Study
+from lawbench.verdicts import Verdict
 
-ANCHOR, TITLE = "stability", "Stability at the extremes"
-COLOURS = {
-    "ok": "#66bb6a",
-    "check failed": "#fff176",
-    "conservation broken": "#ffa726",
-    "clear error": "#b0bec5",
-    "NaN": "#e53935",
-    "time-out": "#8e24aa",
-    "unexpected error": "#4e342e",
-}
+ANCHOR, TITLE, VIEWS = "stability", "Stability at the extremes", ("stability",)
+ATTENTION = (Verdict.UNEXPLAINED, Verdict.NUMERICAL_FAILURE, Verdict.BUDGET)
 
 
-def start(ctx: Context) -> Callable[[], Section]:
-    """Start the section's runs; the returned function builds it."""
-    cells, notes = plan(ctx)
-    batch = ctx.batch("stability", [c.job for c in cells if c.job], checks=["energy_gain"])
-    handles = {
-        k: ctx.guard.submit(tasks.solve_problem, c.law, c.problem, {})
-        for k, c in enumerate(cells)
-        if c.problem is not None
-    }
-    return lambda: _build(ctx, cells, notes, batch.records(), handles)
-
-
-def _judge(ctx: Context, cell: Cell, record: dict[str, Any]) -> dict[str, Any]:
-    case = ctx.case(cell.case)
-    params = case.parameters(**cell.params)
-    problem = cell.problem if cell.problem is not None else case.build(**params)
-    judged = verdict(
-        cell, record, problem, case.momentum_axes(params), ctx.law(cell.law), ctx.config.budget_s
-    )
-    return {
-        "law": cell.law,
-        "axis": cell.axis,
-        "case": cell.case,
-        "value": cell.value,
-        "e": cell.e,
-        **judged,
-        "wall_time_s": record.get("wall_time_s"),
-        "row": cell.row,
-        "reproducer": cell.reproducer(),
-    }
-
-
-def _build(
-    ctx: Context, cells: list[Cell], notes: list[str], records: list, handles: dict
-) -> Section:
-    jobs = iter(records)
+def cells(study: Study, table: pd.DataFrame) -> pd.DataFrame:
+    """One row per cell: law, figure row, swept value, verdict, why, reproducer."""
+    axis = study.axes[0]
+    checks = study.check_names()
     rows = []
-    for k, cell in enumerate(cells):
-        if cell.job is not None:
-            record = next(jobs)
-        else:
-            result = ctx.guard.result(handles[k])
-            record = from_result(result, Job(cell.law, cell.case, cell.params), ctx.config.budget_s)
-        try:
-            rows.append(_judge(ctx, cell, record))
-        except Exception as exc:  # the scene's problem could not be rebuilt: keep the cell
-            detail = f"the report could not judge it: {type(exc).__name__}: {exc}"
-            row = {"law": cell.law, "axis": cell.axis, "case": cell.case, "value": cell.value}
-            row.update(e=cell.e, verdict="unexpected error", detail=detail, row=cell.row)
-            rows.append({**row, "reproducer": cell.reproducer()})
-    frame = pd.DataFrame(rows)
-    config = ctx.config
+    for row in table.fillna({"error_class": ""}).to_dict("records"):
+        params = json.loads(row["params"])
+        others = label({k: params[k] for k in study.grid if k in params}, skip=(axis,))
+        verdict = Verdict(row["verdict"])
+        rows.append(
+            {
+                "law": row["law"],
+                "row": f"{study.title} ({row['case']}{', ' + others if others else ''})",
+                "value": axis_value(row, axis),
+                "verdict": str(verdict),
+                "detail": failure(row) if row["error_class"] else _why(row, verdict, checks),
+                "momentum": row.get("momentum_value", np.nan),
+                "energy": row.get("energy_gain_value", np.nan),
+                "reproducer": row["reproducer"],
+                "exit status": row["exit_status"],
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def _why(row: dict[str, Any], verdict: Verdict, checks: tuple[str, ...]) -> str:
+    """The check that decided a solved cell's verdict, and its detail."""
+    if verdict == Verdict.HOLDS:
+        return ""
+    check = next(c for c in checks if row[f"{c}_verdict"] == str(verdict))
+    return f"{check}: {row[f'{check}_detail']}"
+
+
+def build(ctx: Context) -> Section:
+    """The section, from every stability study that ran."""
+    tables = ctx.tables("stability")
+    frame = pd.concat([cells(s, t) for s, t in tables], ignore_index=True) if tables else None
     blocks: list[Any] = [
-        "Each law at the extremes: stiffness ratios "
-        f"{_span(config.stiffness_ratios)} ({', '.join(config.stiffness_cases)}), the striking "
-        f"ball's mass over the others' {_span(config.mass_ratios)}, grazing approach speeds "
-        f"{_span(config.grazing_speeds)} m/s, chains of {_span(config.chain_lengths)} balls, "
-        f"mu in {{{', '.join(f'{m:g}' for m in config.frictions)}}} on every frictional scene, "
-        "and contact 0 given twice; each crossed with e in "
-        f"{{{', '.join(f'{e:g}' for e in config.restitutions)}}}. Each solve has "
-        f"{config.budget_s:g} s of wall time. Verdicts and errors are defined in "
-        "`lawbench.report.extremes`: momentum error is the impulse-momentum residual and the "
-        "change of conserved momentum over the largest momentum; energy error is |dT| / T- "
-        "for elastic frictionless cells and the energy created otherwise."
-        + "".join(f" Note: {n}." for n in notes)
+        "Each law pushed to the extremes each scene declares: "
+        + "; ".join(f"{s.title} on `{s.cases[0]}`" for s, _ in tables)
+        + f". Each cell has {ctx.config.budget_s:g} s of wall time (the wall-clock guard); its "
+        "verdict is the worst of its checks' verdicts (every single-solve check), or that of "
+        "the error that stopped it.",
+        Legend(),
     ]
-    if frame.empty:
+    if frame is None or frame.empty:
         return Section(ANCHOR, TITLE, [*blocks, "No cell: no law or scene selected."])
     blocks.append(_counts(frame))
-    blocks += _unacceptable(frame)
+    blocks += _attention(frame)
     blocks.append(_errors_figure(frame))
     for law, part in frame.groupby("law", sort=False):
         blocks.append(_law_figure(law, part.reset_index(drop=True)))
     return Section(ANCHOR, TITLE, blocks)
 
 
-def _span(values: tuple[float, ...]) -> str:
-    return f"{min(values):g} to {max(values):g}" if len(values) > 1 else f"{values[0]:g}"
-
-
 def _counts(frame: pd.DataFrame) -> Table:
     counts = pd.crosstab(frame["law"], frame["verdict"]).reindex(
-        columns=list(CATEGORIES), fill_value=0
+        columns=[str(v) for v in Verdict], fill_value=0
     )
-    worst = frame.groupby("law")[["momentum_error", "energy_error"]].max()
-    table = counts.join(worst).reset_index()
-    shown = table.copy()
-    for column in ("momentum_error", "energy_error"):
-        shown[column] = [f"{x:.2g}" if x == x else "" for x in table[column]]
     return Table(
         "stability_summary",
-        "Cells per verdict and the largest momentum and energy errors seen, per law; every "
-        "cell with its verdict is in the CSV of the law's figure below.",
-        shown,
-        table,
+        "Cells per verdict, per law; every cell with its verdict, reason and reproducer is in "
+        "the CSV of the law's figure below.",
+        counts.reset_index(),
     )
 
 
-def _unacceptable(frame: pd.DataFrame) -> list[Any]:
-    bad = frame[frame["verdict"].isin(UNACCEPTABLE)]
+def _attention(frame: pd.DataFrame) -> list[Any]:
+    bad = frame[frame["verdict"].isin([str(v) for v in ATTENTION])]
     if bad.empty:
-        return ["No NaN, time-out or unexpected-error cell."]
-    shown = bad[["law", "row", "value", "verdict", "detail", "reproducer"]]
+        return ["No cell is unexplained, a numerical failure or out of budget."]
+    groups = []
+    for (law, verdict, detail), group in bad.groupby(["law", "verdict", "detail"], sort=False):
+        first = group.iloc[0]
+        values = ", ".join(dict.fromkeys(f"{v:g}" for v in group["value"]))
+        groups.append(
+            {
+                "law": law,
+                "verdict": Mark("", Verdict(verdict), detail),
+                "cells": len(group),
+                "where": f"{first['row']} at {values}",
+                "detail": detail,
+                "reproducer": first["reproducer"],
+                "exit status": first["exit status"],
+            }
+        )
     return [
-        f"{len(bad)} cells gave NaN, ran out of time or raised an unexpected error:",
+        f"{len(bad)} cells are unexplained, numerical failures or out of budget; cells with "
+        "the same reason are one line, with the command that reproduces the first:",
         Table(
-            "stability_unacceptable",
-            "Cells that must not happen, with a command that reproduces each.",
-            shown,
+            "stability_attention",
+            "Cells to look at: the verdict, the reason, and a command that reruns the first "
+            "cell and exits with the status shown (0 answered, 3 refused, 4 budget or solver "
+            "failure).",
+            pd.DataFrame(groups),
+            bad.reset_index(drop=True),
+            commands=("reproducer",),
         ),
     ]
 
@@ -150,29 +135,35 @@ def _unacceptable(frame: pd.DataFrame) -> list[Any]:
 def _errors_figure(frame: pd.DataFrame) -> Figure:
     fig, axes = plots.figure(1, 2, width=6.0, height=3.6)
     laws = list(dict.fromkeys(frame["law"]))
-    answered = frame[frame["momentum_error"].notna()]
-    for ax, column in zip(axes[0], ("momentum_error", "energy_error"), strict=True):
+    panels = (
+        ("momentum", "change of a conserved momentum (relative)"),
+        ("energy", "energy created max(dT, 0) / T-"),
+    )
+    for ax, (column, name) in zip(axes[0], panels, strict=True):
         for k, law in enumerate(laws):
-            values = answered.loc[answered["law"] == law, column].to_numpy()
+            values = frame.loc[frame["law"] == law, column].to_numpy(dtype=float)
+            values = values[np.isfinite(values)]
+            if column == "energy":
+                values = np.maximum(values, 0.0)
             spread = np.linspace(-0.25, 0.25, len(values)) if len(values) > 1 else [0.0]
             style = plots.law_style(law)
             ax.plot(
-                k + np.asarray(spread),
+                k + np.asarray(spread)[: len(values)],
                 plots.floored(values),
                 style["marker"],
                 color=style["color"],
                 alpha=0.6,
                 linestyle="none",
             )
-        ax.axhline(TOLERANCE, color="k", linestyle=":", linewidth=0.8)
         ax.set_xticks(range(len(laws)), laws, rotation=45, ha="right")
-        ax.set(yscale="log", ylabel=column.replace("_", " ") + " (relative)")
-    data = answered[["law", "row", "value", "momentum_error", "energy_error"]]
+        ax.set(yscale="log", ylabel=f"{name}, dimensionless")
+        ax.set_ylim(bottom=plots.FLOOR / 10)
+    data = frame[["law", "row", "value", "momentum", "energy", "verdict"]]
     return Figure(
         "stability_errors",
-        "Momentum and energy errors of every answered cell of the stability grid, per law "
-        f"(exact zeros drawn at {plots.FLOOR:g}; dotted line: the tolerance {TOLERANCE:g} of "
-        "exact laws).",
+        "Momentum and energy checks' values of every answered cell of the stability grid, per "
+        f"law (zeros, and energy kept or lost, drawn at {plots.FLOOR:g}); their verdicts are "
+        "in the grids below.",
         fig,
         data.reset_index(drop=True),
     )
@@ -182,27 +173,27 @@ def _law_figure(law: str, part: pd.DataFrame) -> Figure:
     labels = list(dict.fromkeys(part["row"]))
     width = max(int(part.groupby("row").size().max()), 1)
     image = np.ones((len(labels), width, 3))
-    fig, axes = plots.figure(1, 1, width=1.0 * width + 4.5, height=0.32 * len(labels) + 1.2)
+    fig, axes = plots.figure(1, 1, width=0.9 * width + 5.0, height=0.32 * len(labels) + 1.2)
     ax = axes[0, 0]
-    for r, label in enumerate(labels):
-        for c, cell in enumerate(part[part["row"] == label].itertuples()):
-            image[r, c] = to_rgb(COLOURS[cell.verdict])
+    for r, row_label in enumerate(labels):
+        for c, cell in enumerate(part[part["row"] == row_label].itertuples()):
+            image[r, c] = to_rgb(COLOURS[Verdict(cell.verdict)])
             ax.text(c, r, f"{cell.value:g}", ha="center", va="center", fontsize=6.5)
     ax.imshow(image, aspect="auto", interpolation="nearest")
     ax.set_yticks(range(len(labels)), labels, fontsize=7)
     ax.set_xticks([])
-    present = [v for v in CATEGORIES if v in set(part["verdict"])]
+    present = [v for v in Verdict if str(v) in set(part["verdict"])]
     ax.legend(
-        handles=[Patch(color=COLOURS[v], label=v) for v in present],
+        handles=[Patch(color=COLOURS[v], label=str(v)) for v in present],
         loc="upper left",
         bbox_to_anchor=(1.01, 1.0),
         fontsize="x-small",
     )
-    ax.set_title(f"{law}: verdict per cell (the number is the swept value)")
+    ax.set_title(f"{law}: verdict per cell (the number is the value swept, unit in the row)")
     return Figure(
         f"stability_{law}",
-        f"Stability grid of `{law}`: one row per extreme and scene (with e), one cell per "
-        "value swept; colour: the verdict.",
+        f"Stability grid of `{law}`: one row per extreme and scene (with the other values "
+        "swept), one cell per value; colour: the verdict.",
         fig,
         part.drop(columns=["row"]),
     )

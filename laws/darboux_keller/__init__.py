@@ -167,3 +167,11 @@ def _path(problem: ImpactProblem, record: ImpactRecord) -> dict[str, np.ndarray]
 
 
 LAWS.register(DarbouxKeller())
+
+# The study this law declares: its stick and slip phases, in "inside an impact".
+from lawbench.study import STUDIES  # noqa: E402
+from lawbench.study_shapes import impact_path  # noqa: E402
+
+STUDIES.register(
+    impact_path("darboux_keller", "lamina", "stick and slip phases along the normal impulse")
+)

@@ -234,3 +234,11 @@ def _check_chain(problem: ImpactProblem) -> None:
 
 
 LAWS.register(Jia())
+
+# The study this law declares: its impulse curve, in the report's "inside an impact".
+from lawbench.study import STUDIES  # noqa: E402
+from lawbench.study_shapes import impact_path  # noqa: E402
+
+STUDIES.register(
+    impact_path("jia", "ball_chain", "Jia's impulse curve for two colliding balls", {"n": 2})
+)

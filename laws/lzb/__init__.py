@@ -306,3 +306,12 @@ def _path(impact: EnergeticImpact, problem: ImpactProblem) -> dict[str, np.ndarr
         "force": impact.K * d**impact.eta,
         "primary": primary,
     }
+
+
+# The study this law declares: the energy its contacts exchange, in "inside an impact".
+from lawbench.study import STUDIES  # noqa: E402
+from lawbench.study_shapes import impact_path  # noqa: E402
+
+STUDIES.register(
+    impact_path("lzb", "bead_column", "energy exchanged between the contacts of the bead column")
+)

@@ -1,28 +1,73 @@
-"""Tasks in worker processes, each under a wall-clock budget.
+"""The per-job wall-clock guard: no job runs past its seconds, whatever the law does.
 
-A `Guard` keeps a few worker processes; a task (a module-level function and its arguments) runs
-in one of them and gives a `Result`: its value, or the error it raised, or ``time-out`` when it
-did not answer within its budget. The worker of a task that runs out of time is killed and
-replaced, so no solve can hang the report; a worker that dies is replaced the same way, and a
-worker ends with the process that started it (no orphan keeps computing).
-Warnings raised by a task are recorded with its result instead of being printed.
+Two forms, one rule: a job that has not answered after its budget is stopped and counts as a
+`BudgetExceeded` of the budget ``wall-clock guard``, with the seconds.
+
+- `Guard` keeps a few worker processes; a task (a module-level function and its arguments)
+  runs in one of them and gives a `Result`: its value, the error it raised, or ``time-out``.
+  The worker of a task that runs out of time is killed and replaced, so no task can hang its
+  caller even inside compiled code; a worker that dies is replaced the same way, and a worker
+  ends with the process that started it (no orphan keeps computing). Warnings a task raises
+  are recorded with its result instead of being printed.
+- `alarm` guards a job in this process (the serial executor, ``lawbench solve
+  --max-seconds``): a timer signal raises the `BudgetExceeded` inside the job. It interrupts
+  Python code only, and only in the main thread.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import threading
 import time
 import warnings
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from typing import Any
 
+from lawbench.errors import BudgetExceeded
+
 TIME_OUT = "time-out"
 WARNINGS_KEPT = 10
+# The budget a guard kill names.
+WALL_CLOCK = "wall-clock guard"
+# Seconds a cell may run before the guard stops it, unless told otherwise.
+BUDGET_S = 600.0
+# Where guarded cells run (`lawbench.runner.Executor`): this process, local workers, Dask.
+EXECUTORS = ("serial", "processes", "dask")
+
+
+def stopped(seconds: float) -> BudgetExceeded:
+    """The error of a job stopped by the guard after ``seconds``."""
+    return BudgetExceeded(
+        f"no answer within {seconds:g} s: stopped by the {WALL_CLOCK}", WALL_CLOCK, seconds, seconds
+    )
+
+
+@contextmanager
+def alarm(seconds: float | None) -> Iterator[None]:
+    """Raise `stopped` inside the enclosed code once ``seconds`` have passed.
+
+    No guard when ``seconds`` is None or outside the main thread (signals reach only it).
+    """
+    if not seconds or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def ring(signum: int, frame: Any) -> None:
+        raise stopped(seconds)
+
+    previous = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 @dataclass(frozen=True)
@@ -125,6 +170,18 @@ class Guard:
         while handle not in self._results:
             self._step()
         return self._results.pop(handle)
+
+    def as_completed(self, handles: Iterable[int]) -> Iterator[tuple[int, Result]]:
+        """``(handle, result)`` of each of ``handles``, in the order they finish."""
+        waiting = set(handles)
+        while waiting:
+            done = waiting & self._results.keys()
+            if not done:
+                self._step()
+                continue
+            for handle in sorted(done):
+                waiting.discard(handle)
+                yield handle, self._results.pop(handle)
 
     def close(self) -> None:
         """Stop every worker."""

@@ -1,0 +1,79 @@
+"""What the chain scenes share besides their problem: closed forms and their ground truth.
+
+`lawbench.chains` builds the problems; this module holds the references of free chains and the
+ground truth of every chain scene (compliant integration at the scene's stiffnesses).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from lawbench.case import GroundTruth, Reference
+
+SPRINGS = GroundTruth(
+    why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "
+    "only time integration of the unilateral springs resolves (Brogliato 2010, linear-spring "
+    "limits of the three-ball chain)",
+    law="compliant",
+    options={"tol": 1e-10},
+)
+
+
+def _plastic_velocity(params: Mapping[str, Any]) -> np.ndarray:
+    wall = params.get("wall", False)
+    masses = np.asarray(params["masses"])
+    velocities = np.asarray(params["velocities"])
+    common = 0.0 if wall else float(masses @ velocities / masses.sum())
+    return np.full(len(masses), common)
+
+
+def _plastic_condition(params: Mapping[str, Any]) -> str | None:
+    if any(params["e"]):
+        return "needs e = 0 at every contact"
+    masses = np.asarray(params["masses"])
+    velocities = np.asarray(params["velocities"])
+    # Impulse of the contact right of ball j = momentum the balls 1..j lose.
+    impulses = np.cumsum(masses * (velocities - _plastic_velocity(params)))[:-1]
+    if params.get("wall", False):
+        impulses = np.append(impulses, masses @ velocities)
+    if (impulses < 0).any():
+        return "a contact would need a tensile impulse for the chain to stick"
+    return None
+
+
+# Brogliato, *An introduction to impact dynamics* (2010), remark after equation (29): with
+# e = 0 Moreau's law gives every ball the velocity of the centre of mass (zero against a wall
+# on the right). It holds while every contact impulse of the stuck chain is non-negative.
+PLASTIC_CHAIN = Reference(
+    name="plastic chain",
+    source="Brogliato 2010, remark after eq. (29): Moreau's law at e = 0",
+    law="moreau",
+    v_plus=_plastic_velocity,
+    condition=_plastic_condition,
+)
+
+
+def _cradle_condition(params: Mapping[str, Any]) -> str | None:
+    masses, velocities = params["masses"], params["velocities"]
+    if params.get("wall", False):
+        return "needs a free chain (no wall)"
+    if len(set(masses)) > 1:
+        return "needs equal masses"
+    if any(e != 1.0 for e in params["e"]):
+        return "needs e = 1"
+    if velocities[0] <= 0 or any(velocities[1:]):
+        return "needs the first ball moving right and the others at rest"
+    return None
+
+
+NEWTONS_CRADLE = Reference(
+    name="Newton's cradle",
+    source="textbook solution (Brogliato 2010, 'Textbooks solutions'): the last ball leaves "
+    "with the velocity of the first, the others stay at rest",
+    law="sequential",
+    v_plus=lambda p: np.eye(len(p["masses"]))[-1] * p["velocities"][0],
+    condition=_cradle_condition,
+)
