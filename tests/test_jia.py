@@ -404,3 +404,35 @@ def test_refusals_name_the_reason():
                 contacts=[Contact(), Contact()],
             )
         )
+
+
+@pytest.mark.parametrize("ratio", [1e-12, 1e-8, 1e-4, 1e4, 1e8, 1e12])
+def test_elastic_chain_keeps_energy_at_extreme_stiffness_ratios(ratio):
+    """Three equal balls, e = 1, k2/k1 from 1e-12 to 1e12: energy kept and the spring limits.
+
+    Brogliato 2010 (linear-spring limits of the three-ball chain): a soft second contact lets
+    the stiff first one act alone, so the impacts are sequential and the last ball leaves with
+    the first's velocity, (0, 0, 1); a stiff second contact holds balls 2 and 3 together while
+    ball 1 rebounds off their sum, (-1/3, 2/3, 2/3).
+    """
+    outcome = lawbench.solve("jia", "three_ball_chain", stiffness_ratio=ratio, e=1.0)
+    assert abs(outcome.dT) <= 1e-9 * outcome.T_minus
+    limit = [0.0, 0.0, 1.0] if ratio < 1 else [-1 / 3, 2 / 3, 2 / 3]
+    np.testing.assert_allclose(outcome.v_plus, limit, atol=1e-4)
+
+
+def test_stiff_contact_in_an_inelastic_chain_tends_to_one_limit():
+    """k2/k1 from 1e-6 to 1e-12 at e = 0.5: one answer, the lzb law's at 1e-6.
+
+    Jia, Mason and Erdmann 2013, Theorem 4: a stiff contact kept loaded by its neighbours
+    rebounds again and again and tends to a rigid, plastic contact; a spring that empties at
+    the instant a locked contact releases must still separate.
+    """
+    answers = [
+        lawbench.solve("jia", "three_ball_chain", stiffness_ratio=r, e=0.5).v_plus
+        for r in (1e-6, 1e-8, 1e-10, 1e-12)
+    ]
+    for answer in answers[1:]:
+        np.testing.assert_allclose(answer, answers[0], atol=1e-5)
+    lzb = lawbench.solve("lzb", "three_ball_chain", stiffness_ratio=1e-6, e=0.5, exponent=1.0)
+    np.testing.assert_allclose(answers[0], lzb.v_plus, atol=1e-4)
