@@ -134,6 +134,7 @@ class TwoBallsWall(Case):
         "both approaching": {"velocities": [-2.0, -1.0], "e": [0.5, 0.8]},
         "light outer ball": {"masses": [0.1, 1.0]},
         "separating ball": {"velocities": [-1.0, 0.5], "e": [0.5]},
+        "stiff wall": {"stiffness_ratio": 100.0},
     }
 
     def _check(self, params: dict[str, Any]) -> None:

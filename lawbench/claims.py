@@ -3,8 +3,13 @@
 A law lists the ones that apply to it in its ``findings`` (`lawbench.verdicts.Claim`).
 """
 
-from lawbench.regions import EVERYWHERE, oblique_contacts
-from lawbench.verdicts import Claim
+from lawbench.regions import (
+    EVERYWHERE,
+    oblique_contacts,
+    recompressed_contact,
+    separating_contact,
+)
+from lawbench.verdicts import Claim, Region
 
 PAOLI_DISCONTINUITY = Claim(
     "continuity",
@@ -25,3 +30,43 @@ RIGID_DISPERSION = Claim(
     "energy over the bodies that the stiffness ratios decide in the compliant ground truth",
     (("two_balls_wall", "default"),),
 )
+
+FROZEN_CONFIGURATION = Claim(
+    "dispersion",
+    recompressed_contact,
+    "Liu, Zhao and Brogliato, Proc. R. Soc. A 464 (2008) and Jia, Mason and Erdmann, IJRR 32(1) "
+    "(2013): the springs act at a frozen configuration",
+    "the springs act at a frozen configuration, so a contact whose energy went back to zero "
+    "keeps no gap and is compressed again as soon as it approaches, where the compliant ground "
+    "truth first closes the gap it opened; the energy then spreads differently (two balls on a "
+    "wall 100 times stiffer than the ball contact: v+ = (1.414, 0.014) against (1.008, 0.992) "
+    "with linear springs)",
+    (("two_balls_wall", "stiff wall"),),
+)
+
+
+def separating_held(check: str, region: Region = separating_contact) -> Claim:
+    """Moreau's unilateral law gains energy on a contact that separates before the impact.
+
+    ``check`` is ``energy_gain`` or ``energy_kept``; ``region`` narrows where it applies.
+    """
+    return Claim(
+        check,
+        region,
+        "Brogliato 2010, Moreau's law; dT = sum Pn_j (un-_j + un+_j) / 2",
+        "a contact that separates before the impact, dragged into it by its neighbours, is "
+        "held at un+ = 0 without restitution, and its impulse adds Pn un- / 2 > 0 to the "
+        "energy change: kinematic restitution per contact is not dissipative once a "
+        "separating contact takes part",
+        (("three_ball_chain", "separating contact"),),
+    )
+
+
+def keeps_energy(source: str, reason: str) -> Claim:
+    """The law keeps the energy of elastic frictionless impacts: a loss or gain is numerical."""
+    return Claim("energy_kept", EVERYWHERE, source, reason)
+
+
+def never_creates_energy(source: str, reason: str, region: Region = EVERYWHERE) -> Claim:
+    """The law never creates energy in ``region``: a gain there is numerical."""
+    return Claim("energy_gain", region, source, reason)

@@ -33,6 +33,7 @@ __all__ = [
     "nonlinear_springs",
     "oblique_contacts",
     "option",
+    "recompressed_contact",
     "separating_contact",
 ]
 
@@ -116,4 +117,10 @@ def _nonlinear(trial: Any) -> bool:
 
 nonlinear_springs = Region(
     "several contacts, some with a force law other than linear (exponent != 1)", _nonlinear
+)
+
+
+recompressed_contact = Region(
+    "a contact whose spring gave back all its energy is compressed again within the impact",
+    lambda trial: bool(trial.outcome.diagnostics.get("recompressed")),
 )

@@ -47,6 +47,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.claims import keeps_energy
 from lawbench.errors import NotApplicable
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
@@ -81,6 +82,12 @@ class Brach(Law):
             "Kane and Levinson 1985; Brogliato 2010, after eq. (9) and eq. (11)",
             _REVERSAL_GAIN,
             (("falling_rod", "energy gain"),),
+        ),
+    )
+    guarantees = (
+        keeps_energy(
+            "Brach 1989; Brogliato 2010, eq. (11): without friction the normal law is Newton's",
+            "at e = 1 the contact leaves with un+ = -un-, which keeps the energy",
         ),
     )
 

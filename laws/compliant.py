@@ -50,6 +50,7 @@ import scipy.integrate
 import scipy.optimize
 
 from lawbench import budget
+from lawbench.claims import keeps_energy, never_creates_energy
 from lawbench.errors import BudgetExceeded, NotApplicable, SolverFailure
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
@@ -109,6 +110,16 @@ class Compliant(Law):
     source = "Brogliato 2010, compliant contacts; Hunt and Crossley 1975; Flores et al. 2011"
     tags = Tags(several_contacts=True, stiffness=True, accuracy_knob="tol")
     follows_gaps = True
+    guarantees = (
+        keeps_energy(
+            "Brogliato 2010, compliant contacts; Hunt and Crossley 1975",
+            "at e = 1 every force law is a spring without damping, a conservative system",
+        ),
+        never_creates_energy(
+            "Brogliato 2010, compliant contacts; Hunt and Crossley 1975",
+            "springs with non-negative damping only give back what they stored",
+        ),
+    )
     options = (
         Spec("model", "hunt_crossley", "force law of every contact", kind="str", choices=MODELS),
         Spec("tol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),

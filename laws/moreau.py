@@ -82,7 +82,12 @@ import numpy as np
 
 from lawbench import cones
 from lawbench.batch import ProblemBatch
-from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
+from lawbench.claims import (
+    PAOLI_DISCONTINUITY,
+    RIGID_DISPERSION,
+    keeps_energy,
+    separating_held,
+)
 from lawbench.errors import BudgetExceeded
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
@@ -161,16 +166,8 @@ class Moreau(Law):
     findings = (
         PAOLI_DISCONTINUITY,
         RIGID_DISPERSION,
-        Claim(
-            "energy_gain",
-            separating_contact & option("separating", "unilateral"),
-            "Brogliato 2010, Moreau's law; dT = sum Pn_j (un-_j + un+_j) / 2",
-            "a contact that separates before the impact, dragged into it by its neighbours, is "
-            "held at un+ = 0 without restitution, and its impulse adds Pn un- / 2 > 0 to the "
-            "energy change: kinematic restitution per contact is not dissipative once a "
-            "separating contact takes part",
-            (("three_ball_chain", "separating contact"),),
-        ),
+        separating_held("energy_gain", separating_contact & option("separating", "unilateral")),
+        separating_held("energy_kept", separating_contact & option("separating", "unilateral")),
         Claim(
             "admissible",
             separating_contact & option("separating", "restitution"),
@@ -184,6 +181,13 @@ class Moreau(Law):
             "Kane and Levinson 1985; Brogliato 2010, eq. (8)",
             _SLIP_REVERSAL,
             (("falling_rod", "energy gain"), ("double_pendulum", "default")),
+        ),
+    )
+    guarantees = (
+        keeps_energy(
+            "Brogliato 2010, Moreau's law: dT = sum Pn_j (un-_j + un+_j) / 2",
+            "at e = 1 every contact that takes an impulse leaves with un+ = -un-, so each term "
+            "of dT vanishes",
         ),
     )
 

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.batch import ProblemBatch
-from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
+from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 from lawbench.errors import NotApplicable
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
@@ -61,6 +61,12 @@ class Newton(Law):
             _SOURCE,
             "holding a separating contact to un+ = -e un- needs a tensile impulse",
             (("three_ball_chain", "separating contact"),),
+        ),
+    )
+    guarantees = (
+        keeps_energy(
+            "Brogliato 2010, eq. (29); dT = sum Pn_j (un-_j + un+_j) / 2",
+            "at e = 1 every closed contact leaves with un+ = -un-, so each term of dT vanishes",
         ),
     )
 

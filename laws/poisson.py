@@ -25,12 +25,14 @@ from typing import Any
 import numpy as np
 
 from lawbench.batch import ProblemBatch
-from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
+from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.regions import separating_contact
 from lawbench.solvers import ENUMERATION_MAX, enumerate_lcp, solve_lcp
 from lawbench.tags import Tags
+from lawbench.verdicts import Claim
 
 
 class Poisson(Law):
@@ -43,6 +45,22 @@ class Poisson(Law):
     findings = (
         PAOLI_DISCONTINUITY,
         RIGID_DISPERSION,
+        Claim(
+            "energy_kept",
+            separating_contact,
+            "Pfeiffer and Glocker 1996, ch. 7: the expansion impulse L",
+            "a contact that separates before the impact can be driven to approach by the "
+            "restitution impulses of the others; the impulse L that stops it is plastic and "
+            "takes energy even at e = 1",
+            (("three_ball_chain", "separating contact"),),
+        ),
+    )
+    guarantees = (
+        keeps_energy(
+            "Pfeiffer and Glocker 1996, ch. 7; dT = (1 - e^2) Pc.un- / 2 without L",
+            "at e = 1 the compression impulse Pc restituted in full gives dT = 0 by the "
+            "compression complementarity, and no approaching contact needs L",
+        ),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

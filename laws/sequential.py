@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.claims import RIGID_DISPERSION
+from lawbench.claims import RIGID_DISPERSION, keeps_energy, never_creates_energy
 from lawbench.errors import BudgetExceeded
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
@@ -47,6 +47,16 @@ class Sequential(Law):
     source = "Brogliato 2010, eqs. (27)-(28): sequences of binary impacts"
     tags = Tags(several_contacts=True, accuracy_knob="order")
     findings = (RIGID_DISPERSION,)
+    guarantees = (
+        keeps_energy(
+            "Brogliato 2010, binary impacts",
+            "each binary impact at e = 1 keeps the energy of the pair",
+        ),
+        never_creates_energy(
+            "Brogliato 2010, binary impacts",
+            "each binary impact loses (1 - e^2) of the energy of the pair's relative motion",
+        ),
+    )
     options = (
         Spec(
             "order",

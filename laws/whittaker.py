@@ -77,14 +77,19 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
-from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION
+from lawbench.claims import (
+    PAOLI_DISCONTINUITY,
+    RIGID_DISPERSION,
+    keeps_energy,
+    separating_held,
+)
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.law import LAWS, Law
 from lawbench.lemke import RayTermination, lemke
 from lawbench.mechanics import is_diagonal, kinetic_energy
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
-from lawbench.regions import coupled_friction, separating_contact
+from lawbench.regions import coupled_friction
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim
 
@@ -400,21 +405,21 @@ class Whittaker(Law):
     findings = (
         PAOLI_DISCONTINUITY,
         RIGID_DISPERSION,
-        Claim(
-            "energy_gain",
-            separating_contact,
-            "Brogliato 2010, Moreau's law and separating contacts",
-            "without friction the law is moreau's unilateral LCP: a contact that separates "
-            "before the impact is held at un+ = 0 without restitution, and its impulse adds "
-            "Pn un- / 2 > 0 to the energy change",
-            (("three_ball_chain", "separating contact"),),
-        ),
+        separating_held("energy_gain"),
+        separating_held("energy_kept"),
         Claim(
             "energy_gain",
             coupled_friction,
             "Kane and Levinson 1985; Brogliato 2010, eqs. (6)-(9)",
             _SLIP_REVERSAL,
             (("falling_rod", "energy gain"), ("double_pendulum", "default")),
+        ),
+    )
+    guarantees = (
+        keeps_energy(
+            "Brogliato 2010, Moreau's law: dT = sum Pn_j (un-_j + un+_j) / 2",
+            "without friction the law is Moreau's: at e = 1 every contact that takes an impulse "
+            "leaves with un+ = -un-",
         ),
     )
 

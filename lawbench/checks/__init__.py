@@ -1,6 +1,7 @@
 """Checks of an outcome: each returns a value, a verdict and a reason, or is skipped with one.
 
-Single-solve checks read one trial (a law solved on a case): ``energy_gain``, ``admissible``,
+Single-solve checks read one trial (a law solved on a case): ``energy_gain``, ``energy_kept``,
+``admissible``,
 ``impulse_sign``, ``friction_cone``, ``momentum``, ``reference``; `run_checks` runs them by
 default. ``continuity`` and ``dispersion`` solve the case again and run on request.
 """

@@ -7,6 +7,7 @@ import scipy.linalg
 
 from lawbench.checks.base import TOLERANCE, Trial, check
 from lawbench.mechanics import gap_rates
+from lawbench.problem import RESTITUTION_KINDS
 
 
 def _scale(values: np.ndarray) -> float:
@@ -20,6 +21,26 @@ def energy_gain(trial: Trial) -> tuple:
     relative = outcome.dT / outcome.T_minus if outcome.T_minus > 0 else outcome.dT
     passed = relative <= TOLERANCE
     verb = "creates" if not passed else "keeps or dissipates"
+    return relative, passed, f"{verb} energy: dT = {outcome.dT:.6g} J, T- = {outcome.T_minus:.6g} J"
+
+
+@check("energy_kept")
+def energy_kept(trial: Trial) -> tuple:
+    """Relative kinetic energy change ``dT / T-`` of an elastic, frictionless impact.
+
+    It applies where no contact has friction and every closed contact is elastic (e = 1 in
+    Newton's, Poisson's and the energetic sense alike), where a law that keeps energy must
+    keep it to rounding.
+    """
+    problem, outcome = trial.problem, trial.outcome
+    if problem.frictional:
+        return None, None, "some contact has friction"
+    closed = problem.closed
+    if not all((problem.restitution(kind)[closed] == 1.0).all() for kind in RESTITUTION_KINDS):
+        return None, None, "some closed contact is not elastic (e < 1)"
+    relative = outcome.dT / outcome.T_minus if outcome.T_minus > 0 else outcome.dT
+    passed = abs(relative) <= TOLERANCE
+    verb = "keeps" if passed else ("loses" if relative < 0 else "creates")
     return relative, passed, f"{verb} energy: dT = {outcome.dT:.6g} J, T- = {outcome.T_minus:.6g} J"
 
 

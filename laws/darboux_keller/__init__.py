@@ -66,9 +66,11 @@ from lawbench.laws.darboux_keller.dynamics import (
     path_arrays,
 )
 
+from lawbench.claims import keeps_energy, never_creates_energy
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.regions import option
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 
@@ -86,6 +88,19 @@ class DarbouxKeller(Law):
     )
     source = "Darboux 1880, Keller 1986, Stronge 1990; Brogliato 2010, eqs. (2)-(4), (12)-(15)"
     tags = Tags(friction=True, several_contacts=False, spatial=True, accuracy_knob="tol")
+    guarantees = (
+        keeps_energy(
+            "Stronge 1990; Brogliato 2010, eqs. (12)-(15)",
+            "without friction the three terminations agree, and at e = 1 the expansion gives "
+            "back the work of compression",
+        ),
+        never_creates_energy(
+            "Stronge 1990; Brogliato 2010, eqs. (12)-(15)",
+            "Stronge's termination gives back e^2 of the normal work of compression and "
+            "friction only dissipates",
+            option("termination", "energetic"),
+        ),
+    )
     options = (
         Spec(
             "termination",

@@ -42,12 +42,13 @@ the impact is inactive until its gap rate turns negative.
 Formulations (``diagnostics['formulation']``): frictionless with a diagonal Delassus matrix (one
 contact included), the closed form ``Pn = -(1 + e) un- / G_jj`` (the energetic coefficient
 equals Newton's there); otherwise the spring equations integrated with scipy's DOP853 at the
-relative ``tolerance``, every transition (end of compression, slip, stick, separation,
-reactivation, lock, release) an event; a gap rate above ``-100 tolerance |u-|`` does not count
+relative ``tol``, every transition (end of compression, slip, stick, separation,
+reactivation, lock, release) an event; a gap rate above ``-100 tol |u-|`` does not count
 as approaching. Diagnostics: ``sequence`` (one contact: the modes and events, for
 example slip, stick, end of compression, slip, end of impact; several: the active sets),
 ``events`` (each transition with its ``tau`` and normal impulses), ``steps`` (integrator
-steps), ``compression_loss`` (J, energy taken at the ends of compression). Option ``path``
+steps), ``compression_loss`` (J, energy taken at the ends of compression), ``recompressed``
+(contacts that separated and were compressed again). Option ``path``
 returns the impulse curve: ``tau``, ``Pn`` (k, m), ``Pt`` (k, d), ``En`` (k, m) and ``Et`` (k,)
 the spring energies (J), ``un`` and ``ut`` the contact velocities.
 """
@@ -59,7 +60,12 @@ from typing import Any
 import numpy as np
 from lawbench.laws.jia.dynamics import SpringImpact, Springs
 
-from lawbench.claims import PAOLI_DISCONTINUITY
+from lawbench.claims import (
+    FROZEN_CONFIGURATION,
+    PAOLI_DISCONTINUITY,
+    keeps_energy,
+    never_creates_energy,
+)
 from lawbench.errors import NotApplicable
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
@@ -97,6 +103,7 @@ class Jia(Law):
     )
     findings = (
         PAOLI_DISCONTINUITY,
+        FROZEN_CONFIGURATION,
         Claim(
             "dispersion",
             nonlinear_springs,
@@ -105,6 +112,16 @@ class Jia(Law):
             "contacts the energy spreads over the bodies as it would with linear ones, unlike the "
             "compliant ground truth",
             (("ball_chain", "default"),),
+        ),
+    )
+    guarantees = (
+        keeps_energy(
+            "Jia, Mason and Erdmann, IJRR 32(1) 2013",
+            "at e = 1 no spring changes stiffness, so the springs give back all they store",
+        ),
+        never_creates_energy(
+            "Jia, Mason and Erdmann, IJRR 32(1) 2013; Jia 2013",
+            "energy leaves the springs only at the ends of compression and by tangential slip",
         ),
     )
     options = (
@@ -172,6 +189,7 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
         "events": record.events,
         "steps": record.steps,
         "compression_loss": record.compression_loss,
+        "recompressed": sorted(int(j) for j in record.recompressed),
     }
     if d:
         diagnostics["tangential_stiffness_ratio"] = eta0_sq

@@ -99,7 +99,8 @@ is diagonal and no path is asked (each contact is Stronge's single impact,
 Diagnostics: ``formulation``, ``variant``, ``tol``, ``steps`` (``impulse_steps`` +
 ``time_steps``), ``events``, ``peak_force`` (N, per contact: ``K d^eta`` at the largest
 ``d = ((eta+1) E / K)^(1/(eta+1))``), ``primary_switches`` and ``primaries`` (the successive
-primary contacts, the first 1000), ``cycles`` (per contact, one ``{"compression",
+primary contacts, the first 1000), ``recompressed`` (contacts compressed again after a cycle
+ended), ``cycles`` (per contact, one ``{"compression",
 "restitution", "residual"}`` per cycle, in J: work of compression, work released in expansion,
 energy dissipated at once when the cycle ends), ``normal_work`` and ``friction_work`` (J, per
 contact; their sum is ``dT``), ``duration_s``. Option ``path`` returns ``t`` (s), ``Pn``,
@@ -116,7 +117,12 @@ import scipy.special
 from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 from lawbench import budget
-from lawbench.claims import PAOLI_DISCONTINUITY
+from lawbench.claims import (
+    FROZEN_CONFIGURATION,
+    PAOLI_DISCONTINUITY,
+    keeps_energy,
+    never_creates_energy,
+)
 from lawbench.law import LAWS, Law
 from lawbench.mechanics import is_diagonal
 from lawbench.outcome import Outcome
@@ -135,7 +141,19 @@ class LiuZhaoBrogliato(Law):
     )
     source = "Brogliato 2010, eqs. (32)-(48); Liu, Zhao, Brogliato 2008, 2009; Zhang et al. 2013"
     tags = Tags(friction=True, several_contacts=True, stiffness=True, accuracy_knob="tol")
-    findings = (PAOLI_DISCONTINUITY,)
+    findings = (PAOLI_DISCONTINUITY, FROZEN_CONFIGURATION)
+    guarantees = (
+        keeps_energy(
+            "Liu, Zhao and Brogliato, Proc. R. Soc. A 464 (2008), eq. (42)",
+            "at e* = 1 every cycle gives back in expansion the work of its compression",
+        ),
+        never_creates_energy(
+            "Liu, Zhao and Brogliato, Proc. R. Soc. A 464 (2008), eq. (42); Int. J. Solids "
+            "Struct. 46 (2009)",
+            "each cycle gives back e*^2 of its compression work and Coulomb friction only "
+            "dissipates",
+        ),
+    )
     options = (
         Spec(
             "variant",
@@ -266,6 +284,7 @@ def _describe(
             float(K * (r.peak_s * impact.L) ** eta)
             for K, eta, r in zip(impact.K, impact.eta, impact.records, strict=True)
         ],
+        recompressed=[j for j, r in enumerate(impact.records) if len(r.cycles) > 1],
         primary_switches=impact.switches,
         primaries=impact.primaries[:RECORDED],
         cycles=[
