@@ -21,6 +21,7 @@ from lawbench.errors import (
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import Contact, ImpactProblem
+from lawbench.problem_files import load_problem, save_problem
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim, Region, Verdict
@@ -53,7 +54,9 @@ __all__ = [
     "Trial",
     "Verdict",
     "evaluate",
+    "load_problem",
     "run_checks",
+    "save_problem",
     "solve",
     "solve_batch",
 ]

@@ -492,3 +492,21 @@ def test_path_and_diagnostics():
     assert diagnostics["steps"] == diagnostics["impulse_steps"] + diagnostics["time_steps"]
     assert diagnostics["impulse_steps"] > diagnostics["time_steps"]
     assert diagnostics["variant"] == "bi" and diagnostics["tol"] == 1e-10
+
+
+@pytest.mark.parametrize("law", ["lzb", "jia"])
+def test_a_contact_compressed_again_is_the_declared_frozen_configuration_finding(law):
+    """PHYSICS_NOTES (LZB): the departure from the springs on two balls and a stiff wall is
+    the law's, and its dispersion verdict names that finding; where no contact is compressed
+    again (a soft wall) the same check holds against the compliant ground truth.
+    """
+    from lawbench.claims import FROZEN_CONFIGURATION
+    from lawbench.verdicts import Verdict
+
+    stiff = lawbench.evaluate(law, "two_balls_wall", stiffness_ratio=100.0)
+    assert stiff.outcome.diagnostics["recompressed"] == [1]
+    result = lawbench.run_checks(stiff, ["dispersion"])["dispersion"]
+    assert (result.verdict, result.claim) == (Verdict.LAW_PROPERTY, FROZEN_CONFIGURATION)
+    soft = lawbench.evaluate(law, "two_balls_wall", stiffness_ratio=0.01, exponent=1.0)
+    assert soft.outcome.diagnostics["recompressed"] == []
+    assert lawbench.run_checks(soft, ["dispersion"])["dispersion"].verdict is Verdict.HOLDS

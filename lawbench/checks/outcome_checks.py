@@ -9,6 +9,9 @@ from lawbench.checks.base import TOLERANCE, Trial, check
 from lawbench.mechanics import gap_rates
 from lawbench.problem import RESTITUTION_KINDS
 
+# Rounding allowed on a gap rate, relative to the sum of the velocities it is the difference of.
+ROUNDING = 1e3 * float(np.finfo(float).eps)
+
 
 def _scale(values: np.ndarray) -> float:
     return float(np.abs(values).max()) if values.size and np.abs(values).max() > 0 else 1.0
@@ -46,15 +49,24 @@ def energy_kept(trial: Trial) -> tuple:
 
 @check("admissible", promised=True)
 def admissible(trial: Trial) -> tuple:
-    """Smallest post-impact gap rate of the closed contacts over the largest pre-impact one."""
-    closed = trial.problem.closed
+    """Smallest post-impact gap rate of the closed contacts over the pre-impact contact speed.
+
+    The speed is the largest pre-impact contact velocity, normal or tangential: a grazing
+    approach is judged against the speed at which the contact moves. Gap rates are
+    differences of body velocities, so rounding of the order of ``ROUNDING |Wn|^T |v+|`` is
+    allowed as well.
+    """
+    problem = trial.problem
+    closed = problem.closed
     if not closed.any():
         return None, None, "no closed contact"
-    before = trial.problem.un[closed]
-    after = gap_rates(trial.problem, trial.outcome.v_plus)[closed]
-    value = float(after.min()) / _scale(before)
+    speed = _scale(np.concatenate([problem.un[closed], problem.ut]))
+    v_plus = trial.outcome.v_plus
+    after = gap_rates(problem, v_plus)[closed]
+    rounding = ROUNDING * float((abs(problem.Wn).T @ np.abs(v_plus))[closed].max())
+    value = float(after.min()) / speed
     worst = int(np.flatnonzero(closed)[np.argmin(after)])
-    if value >= -TOLERANCE:
+    if after.min() >= -(TOLERANCE * speed + rounding):
         return value, True, "no closed contact approaches after the impact"
     return value, False, f"contact {worst} approaches after the impact (un+ = {after.min():.6g})"
 
