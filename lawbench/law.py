@@ -19,6 +19,7 @@ import numpy as np
 
 from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.mechanics import separating_contacts
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.registry import Registry
@@ -48,6 +49,13 @@ class Law(ABC):
     # (findings), and where one must hold, so that a failure there is numerical (guarantees).
     findings: ClassVar[tuple[Claim, ...]] = ()
     guarantees: ClassVar[tuple[Claim, ...]] = ()
+    # How the law treats a closed contact that separates before the impact, stated in the
+    # diagnostics of every problem that has one; a law that states no rule refuses them.
+    separating_rule: ClassVar[str] = ""
+
+    def rule_for_separating(self, options: dict[str, Any]) -> str:
+        """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
+        return self.separating_rule
 
     def option_values(self, given: dict[str, Any] | None = None) -> dict[str, Any]:
         """Return every option of this law, defaults filled in, checked and converted.
@@ -101,6 +109,13 @@ class Law(ABC):
         reason = self.tags.refusal(problem)
         if reason:
             raise NotApplicable(f"{self.name}: {reason}")
+        separating = separating_contacts(problem)
+        rule = self.rule_for_separating(values) if separating else ""
+        if separating and not rule:
+            raise NotApplicable(
+                f"{self.name}: closed contacts {separating} separate before the impact, and the "
+                "law states no rule for them"
+            )
         closed = problem.closed
         start = time.perf_counter()
         if closed.all() or self.follows_gaps:
@@ -119,6 +134,9 @@ class Law(ABC):
             if not np.all(np.isfinite(getattr(outcome, field))):
                 raise SolverFailure(f"{self.name}: non-finite {field} {getattr(outcome, field)}")
         outcome.diagnostics["options"] = values
+        if separating:
+            outcome.diagnostics["separating_contacts"] = separating
+            outcome.diagnostics["separating_rule"] = rule
         outcome.diagnostics["wall_time_s"] = wall_time
         return outcome
 

@@ -13,11 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.mechanics import kinetic_angles
+from lawbench.mechanics import kinetic_angles, separating_contacts
 from lawbench.verdicts import EVERYWHERE, Region
 
-# A closed contact separates when its gap rate exceeds this fraction of the largest rate.
-SEPARATING = 1e-12
 # Relative size of a normal-tangential Delassus entry that counts as coupling.
 COUPLING = 1e-9
 # Kinetic angles within this many degrees of 90 count as orthogonal.
@@ -39,10 +37,7 @@ __all__ = [
 
 
 def _separating(trial: Any) -> bool:
-    problem = trial.problem
-    un = problem.un[problem.closed]
-    scale = float(np.abs(problem.un).max()) or 1.0
-    return bool((un > SEPARATING * scale).any())
+    return bool(separating_contacts(trial.problem))
 
 
 separating_contact = Region("a closed contact separates before the impact", _separating)

@@ -109,6 +109,10 @@ class Compliant(Law):
     )
     source = "Brogliato 2010, compliant contacts; Hunt and Crossley 1975; Flores et al. 2011"
     tags = Tags(several_contacts=True, stiffness=True, accuracy_knob="tol")
+    separating_rule = (
+        "a separating contact carries a force only while its spring is compressed, if the "
+        "motion closes it again"
+    )
     follows_gaps = True
     guarantees = (
         keeps_energy(

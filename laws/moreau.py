@@ -120,6 +120,13 @@ class Moreau(Law):
         "2011; Anitescu 2006"
     )
     tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="tol")
+
+    def rule_for_separating(self, options: dict[str, Any]) -> str:
+        """The rule of option ``separating``."""
+        if options["separating"] == "unilateral":
+            return "a separating contact is held at un+ >= 0 without restitution (e min(un-, 0))"
+        return "every closed contact is restituted, un+ >= -e un-, a separating one too"
+
     options = (
         Spec(
             "tol",

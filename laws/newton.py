@@ -44,6 +44,10 @@ class Newton(Law):
     summary = "Newton's kinematic restitution at every closed contact at once"
     source = "Newton's law; generalized Newton law, Brogliato 2010, eq. (29)"
     tags = Tags(several_contacts=True)
+    separating_rule = (
+        "every closed contact is restituted, un+ = -e un-: a separating contact is asked "
+        "to approach and may take a tensile impulse (tensile_contacts)"
+    )
 
     findings = (
         PAOLI_DISCONTINUITY,

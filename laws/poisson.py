@@ -42,6 +42,10 @@ class Poisson(Law):
     summary = "Poisson's kinetic restitution: compression then expansion complementarity problems"
     source = "Pfeiffer and Glocker 1996, ch. 7; Brogliato 2010, kinetic coefficient"
     tags = Tags(several_contacts=True)
+    separating_rule = (
+        "a separating contact takes a compression impulse only when the others make it "
+        "approach, and in expansion only the impulse L that keeps it from approaching"
+    )
     findings = (
         PAOLI_DISCONTINUITY,
         RIGID_DISPERSION,

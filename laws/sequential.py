@@ -46,6 +46,10 @@ class Sequential(Law):
     summary = "pairwise binary Newton impacts in a chosen order until no contact approaches"
     source = "Brogliato 2010, eqs. (27)-(28): sequences of binary impacts"
     tags = Tags(several_contacts=True, accuracy_knob="order")
+    separating_rule = (
+        "binary impacts strike approaching contacts only: a separating contact takes part "
+        "once the others make it approach"
+    )
     findings = (RIGID_DISPERSION,)
     guarantees = (
         keeps_energy(

@@ -73,3 +73,33 @@ def test_a_law_finding_covers_a_user_problem_through_its_region():
     results = lawbench.run_checks(lawbench.evaluate("newton", problem))
     assert results["impulse_sign"].verdict == Verdict.LAW_PROPERTY
     assert "separates before the impact" in results["impulse_sign"].claim.region.text
+
+
+@pytest.mark.parametrize("law", sorted(lawbench.LAWS.names()))
+def test_a_separating_contact_is_treated_by_a_stated_rule(law):
+    """Every law states how it treats a closed contact that separates before the impact, and
+    the outcome names the contacts and the rule; a negative impulse carries its verdict."""
+    M, Wn = np.eye(3), [[-1.0, 0.0], [1.0, -1.0], [0.0, 1.0]]
+    problem = lawbench.ImpactProblem.from_arrays(M, Wn, [1.0, 0.0, 0.75], e=1.0)
+    try:
+        trial = lawbench.evaluate(law, problem)
+    except lawbench.NotApplicable:
+        return
+    assert trial.outcome.diagnostics["separating_contacts"] == [1]
+    assert trial.outcome.diagnostics["separating_rule"]
+    if (trial.outcome.Pn < 0).any():
+        sign = lawbench.run_checks(trial)["impulse_sign"]
+        assert sign.verdict in (Verdict.LAW_PROPERTY, Verdict.NUMERICAL_FAILURE)
+        assert sign.claim is not None
+
+
+def test_a_law_that_states_no_rule_refuses_separating_contacts():
+    """A law without a rule for separating contacts says so instead of answering."""
+
+    class Silent(type(lawbench.LAWS.get("newton"))):
+        separating_rule = ""
+
+    M, Wn = np.eye(3), [[-1.0, 0.0], [1.0, -1.0], [0.0, 1.0]]
+    problem = lawbench.ImpactProblem.from_arrays(M, Wn, [1.0, 0.0, 0.75], e=1.0)
+    with pytest.raises(lawbench.NotApplicable, match=r"closed contacts \[1\] separate"):
+        Silent().resolve(problem)

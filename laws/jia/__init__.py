@@ -101,6 +101,10 @@ class Jia(Law):
         stiffness=True,
         accuracy_knob="tol",
     )
+    separating_rule = (
+        "a separating contact is inactive until its gap rate turns negative, then it is "
+        "compressed like any other"
+    )
     findings = (
         PAOLI_DISCONTINUITY,
         FROZEN_CONFIGURATION,
