@@ -142,3 +142,29 @@ def test_a_new_law_and_scene_need_no_baseline_edit(plugin_env):
     done = lawbench_cli(env, "regress", "--laws", "mirror,newton", "--cases", "ball_on_wall")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "no baseline yet for mirror on ball_on_wall" in done.stdout
+
+
+REPORT = """
+import dataclasses, pathlib, sys
+from lawbench.report import write_report
+from lawbench.report.config import QUICK
+
+config = dataclasses.replace(QUICK, laws=("mirror", "newton"), cases=("ball_on_wall",), workers=1)
+write_report(pathlib.Path(sys.argv[1]), config=config)
+"""
+
+
+def test_the_report_shows_the_plugin_law_on_the_plugin_scene(plugin_env, tmp_path):
+    """The summary matrix of a report restricted to the plugin's law and scene shows both."""
+    _, env = plugin_env
+    done = subprocess.run(
+        [sys.executable, "-c", REPORT, str(tmp_path / "report")],
+        capture_output=True,
+        text=True,
+        env=env,
+    )
+    assert done.returncode == 0, done.stderr
+    page = (tmp_path / "report" / "report.md").read_text()
+    assert "Scenes: `ball_on_wall`" in page
+    rows = [line for line in page.splitlines() if line.startswith("| mirror | ")]
+    assert any("energy_g✓" in row for row in rows)  # the summary matrix: its checks hold
