@@ -427,3 +427,22 @@ def test_report_writes_its_three_files(tmp_path):
 def test_frictional_bad_input_has_the_right_exit_code(args, code, pattern):
     line = assert_one_line_error(run_lawbench(*args), code)
     assert re.search(pattern, line), line
+
+
+HEAVY = ("scipy.integrate", "cvxpy", "pandas", "matplotlib", "dask")
+
+
+@pytest.mark.parametrize("argv", [["list"], ["solve", "newton", "three_ball_chain"]])
+def test_small_commands_import_no_heavy_library(argv):
+    """Laws register by name; an integrator, a table or plotting library loads on first use."""
+    code = (
+        "import contextlib, io, sys\n"
+        "from lawbench.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        f"    main({argv!r})\n"
+        f"print(sorted(m for m in sys.modules if m.split('.')[0] in {HEAVY!r} "
+        f"or m.startswith('scipy.integrate')))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"

@@ -33,7 +33,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.optimize
-from scipy.integrate import solve_ivp
 
 from lawbench.errors import NotApplicable, SolverFailure
 
@@ -261,6 +260,8 @@ class SingleContactImpact:
         smooth, and ``ut = 0`` is a rest point the integrator cannot step across (in ``Pn`` the
         direction ``ut/|ut|`` jumps there and explicit steps chatter about zero).
         """
+        from scipy.integrate import solve_ivp  # on first use: registering imports none
+
         self.record.enter("slip", 0.0)
         for _ in range(MAX_PHASES):
             if self.record.compression is not None and self._reached(state):

@@ -62,7 +62,6 @@ from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from lawbench.errors import SolverFailure
 
@@ -273,6 +272,8 @@ class SpringImpact:
 
     def run(self) -> np.ndarray:
         """Integrate the impact; return the final state ``[I_n, y, I_t, g]``."""
+        from scipy.integrate import solve_ivp  # on first use: registering imports none
+
         tau, s = 0.0, np.zeros(2 * (self.m + self.d))
         self._note_state(tau, s, ["stick" if self.stick else "slip"] if self.d else [])
         for _ in range(MAX_SEGMENTS):

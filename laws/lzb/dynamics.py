@@ -30,7 +30,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.integrate
 import scipy.optimize
 
 from lawbench import budget
@@ -134,6 +133,8 @@ class EnergeticImpact:
     ) -> None:
         self.deadline = budget.Deadline("lzb", max_seconds)
         self.problem, self.variant, self.rtol = problem, variant, rtol
+        import scipy.integrate  # on first use: registering the law imports no integrator
+
         self.method = getattr(scipy.integrate, method)
         self.max_steps, self.max_events, self.record_path = max_steps, max_events, record_path
         m = self.m = problem.m
