@@ -21,12 +21,23 @@ from lawbench.errors import (
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import Contact, ImpactProblem
-from lawbench.problem_files import load_problem, save_problem
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim, Region, Verdict
 
 __version__ = importlib.metadata.version("lawbench")
+
+# Problem files need scipy.sparse and, for HDF5, h5py: loaded when first asked for.
+_FILES = ("load_problem", "save_problem")
+
+
+def __getattr__(name: str) -> object:
+    if name in _FILES:
+        from lawbench import problem_files
+
+        return getattr(problem_files, name)
+    raise AttributeError(f"module 'lawbench' has no attribute {name!r}")
+
 
 __all__ = [
     "CASES",

@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-import scipy.linalg
 
 from lawbench.errors import InvalidProblem
 
@@ -92,6 +91,19 @@ class Contact:
             raise ValueError(f"unknown restitution kind {kind!r}")
         override = getattr(self, f"e_{kind}")
         return self.e if override is None else override
+
+
+def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray:
+    """``M^-1 rhs`` from M's lower Cholesky factor.
+
+    numpy's solves for a small M (no scipy.linalg to import), scipy's triangular ones beyond.
+    """
+    factor = cholesky[0]
+    if factor.shape[0] <= SMALL:
+        return np.linalg.solve(factor.T, np.linalg.solve(factor, rhs))
+    import scipy.linalg
+
+    return scipy.linalg.cho_solve(cholesky, rhs, check_finite=False)
 
 
 def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
@@ -252,7 +264,7 @@ class ImpactProblem:
         """
         W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            inverse = scipy.linalg.cho_solve(self._cholesky, np.eye(self.n), check_finite=False)
+            inverse = _cho_solve(self._cholesky, np.eye(self.n))
         if not np.isfinite(inverse).all():
             diagonal = np.diag(self.M)
             raise InvalidProblem(
@@ -303,7 +315,7 @@ class ImpactProblem:
         inverse = self.__dict__.get("_inverse")
         if inverse is not None:
             return inverse @ rhs
-        return scipy.linalg.cho_solve(self._cholesky, rhs, check_finite=False)
+        return _cho_solve(self._cholesky, rhs)
 
     @cached_property
     def delassus(self) -> np.ndarray:

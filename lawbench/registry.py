@@ -4,8 +4,10 @@ Each module of ``lawbench.laws`` (``lawbench.cases``) registers its entry when i
 distributions add entries through entry points of the group of the same name
 (``[project.entry-points."lawbench.laws"]``): an entry point names a module (importing it
 registers its entries, like the built-in ones) or a `Law`/`Case` subclass or instance (the
-registry registers it). Everything is imported the first time a registry is asked for a name,
-so importing lawbench stays cheap. A module or plugin that fails to import, raises, or
+registry registers it). Asked for one name, a registry imports the module of that name (a
+built-in module or a plugin's entry point) and only that, when it registers the name; asked
+for every name, it imports everything. So importing lawbench, and solving with one law on one
+scene, stay cheap. A module or plugin that fails to import, raises, or
 registers a name twice is skipped and its reason kept in `Registry.unavailable` instead of
 breaking the others.
 """
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.metadata
+import importlib.util
 import inspect
 import pkgutil
 from collections.abc import Iterator
@@ -72,6 +75,23 @@ class Registry(Generic[Entry]):
             except Exception as exc:  # a broken plugin is reported, the others still load
                 self.unavailable[point.name] = f"plugin {point.value}: {type(exc).__name__}: {exc}"
 
+    def _load_one(self, name: str) -> None:
+        """Import the built-in module called ``name``, or the plugin of that name, if any."""
+        if self._loaded or not name.isidentifier() or name.startswith("_"):
+            return
+        module = f"{self.package}.{name}"
+        try:
+            if importlib.util.find_spec(module) is not None:
+                importlib.import_module(module)
+                return
+        except ImportError:
+            return  # the full load records why
+        for point in importlib.metadata.entry_points(group=self.package, name=name):
+            try:
+                self._plug(point.load())
+            except Exception:  # the full load records why
+                return
+
     def _plug(self, loaded: object) -> None:
         """Register what an entry point names: a module registered itself on import."""
         if inspect.ismodule(loaded):
@@ -94,7 +114,10 @@ class Registry(Generic[Entry]):
         """
         if not isinstance(name, str):
             return name
-        self._load()
+        if name not in self._entries:
+            self._load_one(name)
+        if name not in self._entries:
+            self._load()
         try:
             return self._entries[name]
         except KeyError:

@@ -172,7 +172,7 @@ def test_coulombs_law_with_separating_contacts(d, separating):
 
 def test_polished_answers_satisfy_the_cone_conditions_to_rounding():
     """The refined answers satisfy De Saxce's cone complementarity to rounding, and lie within
-    clarabel's accuracy of the raw interior-point answers.
+    clarabel's accuracy of the raw interior-point answers (or the raw path fails and says how).
     """
     for d in (1, 2):
         for seed in range(4):
@@ -185,6 +185,11 @@ def test_polished_answers_satisfy_the_cone_conditions_to_rounding():
             assert cones.residual(G, q, mu, d, P, True) <= 1e-13 * scale
             try:
                 raw = MOREAU.resolve(problem, polish=False)
+            except lawbench.BudgetExceeded as failure:
+                # Unpolished answers carry clarabel's accuracy (~1e-8): the fixed point on mu
+                # |ut+| can stall above its 1e-10 tolerance, and says so.
+                assert failure.budget == "max_steps"
+                continue
             except lawbench.SolverFailure as failure:
                 assert "AlmostSolved" in str(failure)
                 continue

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 from lawbench.checks.base import TOLERANCE, Trial, check
 from lawbench.mechanics import gap_rates
@@ -108,6 +107,8 @@ def momentum(trial: Trial) -> tuple:
     if trial.case is not None:
         axes = trial.case.momentum_axes(trial.params)
     else:
+        import scipy.linalg  # on first use: a scene's solve and check import no scipy.linalg
+
         free = scipy.linalg.null_space(trial.problem.W.T)
         axes = free.T if free.size else None
     if axes is None:
