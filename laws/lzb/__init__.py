@@ -118,6 +118,7 @@ from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 from lawbench import budget
 from lawbench.claims import (
+    ENERGETIC_DISSIPATION,
     FROZEN_CONFIGURATION,
     PAOLI_DISCONTINUITY,
     keeps_energy,
@@ -141,7 +142,7 @@ class LiuZhaoBrogliato(Law):
     )
     source = "Brogliato 2010, eqs. (32)-(48); Liu, Zhao, Brogliato 2008, 2009; Zhang et al. 2013"
     tags = Tags(friction=True, several_contacts=True, stiffness=True, accuracy_knob="tol")
-    findings = (PAOLI_DISCONTINUITY, FROZEN_CONFIGURATION)
+    findings = (PAOLI_DISCONTINUITY, FROZEN_CONFIGURATION, ENERGETIC_DISSIPATION)
     guarantees = (
         keeps_energy(
             "Liu, Zhao and Brogliato, Proc. R. Soc. A 464 (2008), eq. (42)",
