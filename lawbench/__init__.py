@@ -2,7 +2,8 @@
 
 The entry point is `solve` (or `evaluate`, which also keeps the problem and parameters for the
 checks): a law on a registered scene or on an `ImpactProblem` of your own. Laws and cases are
-in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`.
+in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`. `fit`
+identifies a law's coefficients from measured pre- and post-impact velocities.
 """
 
 import importlib.metadata
@@ -18,6 +19,7 @@ from lawbench.errors import (
     NotApplicable,
     SolverFailure,
 )
+from lawbench.fitting import FitResult, fit
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import Contact, ImpactProblem
@@ -36,6 +38,7 @@ __all__ = [
     "CheckResult",
     "Claim",
     "Contact",
+    "FitResult",
     "GroundTruth",
     "ImpactProblem",
     "InvalidProblem",
@@ -53,6 +56,7 @@ __all__ = [
     "Trial",
     "Verdict",
     "evaluate",
+    "fit",
     "run_checks",
     "solve",
     "solve_batch",
