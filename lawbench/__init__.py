@@ -2,9 +2,11 @@
 
 The entry point is `solve` (or `evaluate`, which also keeps the problem and parameters for the
 checks): a law on a registered scene or on an `ImpactProblem` of your own. Laws and cases are
-in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`.
+in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`. `fit`
+identifies a law's coefficients from measured pre- and post-impact velocities.
 """
 
+import importlib
 import importlib.metadata
 
 from lawbench.api import evaluate, solve, solve_batch
@@ -27,15 +29,19 @@ from lawbench.verdicts import Claim, Region, Verdict
 
 __version__ = importlib.metadata.version("lawbench")
 
-# Problem files need scipy.sparse and, for HDF5, h5py: loaded when first asked for.
-_FILES = ("load_problem", "save_problem")
+# Loaded when first asked for: problem files need scipy.sparse (and h5py for HDF5), fitting
+# needs pandas and scipy.optimize.
+_LAZY = {
+    "load_problem": "lawbench.problem_files",
+    "save_problem": "lawbench.problem_files",
+    "fit": "lawbench.fitting",
+    "FitResult": "lawbench.fitting",
+}
 
 
 def __getattr__(name: str) -> object:
-    if name in _FILES:
-        from lawbench import problem_files
-
-        return getattr(problem_files, name)
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'lawbench' has no attribute {name!r}")
 
 
@@ -48,6 +54,7 @@ __all__ = [
     "CheckResult",
     "Claim",
     "Contact",
+    "FitResult",
     "GroundTruth",
     "ImpactProblem",
     "InvalidProblem",
@@ -65,6 +72,7 @@ __all__ = [
     "Trial",
     "Verdict",
     "evaluate",
+    "fit",
     "load_problem",
     "run_checks",
     "save_problem",

@@ -5,6 +5,7 @@ A law lists the ones that apply to it in its ``findings`` (`lawbench.verdicts.Cl
 
 from lawbench.regions import (
     EVERYWHERE,
+    dissipative_contacts,
     oblique_contacts,
     recompressed_contact,
     separating_contact,
@@ -42,6 +43,19 @@ FROZEN_CONFIGURATION = Claim(
     "wall 100 times stiffer than the ball contact: v+ = (1.414, 0.014) against (1.008, 0.992) "
     "with linear springs)",
     (("two_balls_wall", "stiff wall"),),
+)
+
+ENERGETIC_DISSIPATION = Claim(
+    "dispersion",
+    dissipative_contacts,
+    "Liu, Zhao and Brogliato, Proc. R. Soc. A 464 (2008) and Jia, Mason and Erdmann, IJRR 32(1) "
+    "(2013): the energy is taken at each end of compression; Brogliato 2010, compliant models",
+    "an energetic coefficient takes the energy at the end of each compression, a dashpot all "
+    "along the impact, and the two spread the remaining energy differently over the bodies; "
+    "the compliant ground truth is itself one damping rule among several (ping-pong stack at "
+    "e = 0.950043, 0.846529, k2/k1 = 3: jia v+ = (1.057, 0.551) v0, compliant Hunt-Crossley "
+    "(1.160, 0.433) v0, Kelvin-Voigt (1.192, 0.463) v0; all three agree at e = 1)",
+    (("ping_pong", "default"),),
 )
 
 

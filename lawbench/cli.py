@@ -321,6 +321,46 @@ def _regress(args: argparse.Namespace) -> None:
     print("regress: every law holds its baseline")
 
 
+def _fit(args: argparse.Namespace) -> None:
+    from lawbench.fitting import fit
+
+    laws = [name.strip() for name in args.law.split(",") if name.strip()]
+    if not laws:
+        raise InvalidProblem("fit: give a law (or several, comma-separated)")
+    start = {k: float(_number(k, v)) for k, v in _assignments(args.start, "--start").items()}
+    results = [
+        fit(
+            law,
+            args.case,
+            args.data,
+            free=args.free.split(","),
+            params=_assignments(args.set, "--set"),
+            options=_assignments(args.option, "--option") if len(laws) == 1 else None,
+            start=start,
+            noise=args.noise,
+            holdout=args.holdout,
+            bootstrap=args.bootstrap,
+            seed=args.seed,
+        )
+        for law in laws
+    ]
+    if args.json:
+        print(json.dumps([r.to_dict() for r in results], indent=1, allow_nan=False))
+        return
+    print("\n\n".join(r.text() for r in results))
+    if len(results) > 1 and args.holdout:
+        print("\nlaws on the held-back trials (rms residual, best first):")
+        for r in sorted(results, key=lambda r: r.holdout_rms or 0.0):
+            print(f"  {r.law:<16}{r.holdout_rms:.4g}")
+
+
+def _number(name: str, text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise InvalidProblem(f"--start {name}={text!r}: not a number") from None
+
+
 def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
     """The options of the commands that run many cells: executor, workers, guard."""
     parser.add_argument("--executor", choices=EXECUTORS, default=default)
@@ -453,6 +493,43 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--random", type=int, default=3, help="seeded random problems (3)")
     check.add_argument("--json", action="store_true", help="print the table as JSON records")
     check.set_defaults(run=_check)
+    fitp = commands.add_parser(
+        "fit", help="identify a law's coefficients from measured pre/post-impact velocities"
+    )
+    fitp.add_argument("law", help="a law, or several comma-separated to compare them")
+    fitp.add_argument("case", help="the scene of the experiment")
+    fitp.add_argument(
+        "--data",
+        required=True,
+        metavar="CSV",
+        help="one row per trial; columns COORD_minus and COORD_plus per coordinate (v1_minus,...)",
+    )
+    fitp.add_argument(
+        "--free",
+        required=True,
+        metavar="NAMES",
+        help="comma-separated coefficients to fit: a parameter (e, mu, stiffness_ratio) or one "
+        "entry of a list (e[1])",
+    )
+    fitp.add_argument(
+        "--set", action="append", default=[], metavar="NAME=VALUE", help="a fixed parameter"
+    )
+    fitp.add_argument(
+        "--option", action="append", default=[], metavar="NAME=VALUE", help="a law option"
+    )
+    fitp.add_argument(
+        "--start", action="append", default=[], metavar="NAME=VALUE", help="a starting value"
+    )
+    fitp.add_argument(
+        "--noise", type=float, help="standard deviation of a measured velocity (judges the fit)"
+    )
+    fitp.add_argument(
+        "--holdout", type=float, default=0.0, metavar="FRACTION", help="trials held back"
+    )
+    fitp.add_argument("--bootstrap", type=int, default=0, metavar="N", help="bootstrap refits")
+    fitp.add_argument("--seed", type=int, default=0, help="seed of the holdout and bootstrap")
+    fitp.add_argument("--json", action="store_true", help="print the results as JSON")
+    fitp.set_defaults(run=_fit)
     bench = commands.add_parser(
         "bench", help="time the laws against clarabel and numpy called directly (ratios)"
     )

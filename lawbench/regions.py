@@ -24,6 +24,7 @@ ORTHOGONAL_DEG = 1e-6
 __all__ = [
     "EVERYWHERE",
     "coupled_friction",
+    "dissipative_contacts",
     "elastic",
     "example",
     "frictional",
@@ -118,4 +119,15 @@ nonlinear_springs = Region(
 recompressed_contact = Region(
     "a contact whose spring gave back all its energy is compressed again within the impact",
     lambda trial: bool(trial.outcome.diagnostics.get("recompressed")),
+)
+
+
+def _dissipative(trial: Any) -> bool:
+    problem = trial.problem
+    closed = problem.closed
+    return int(closed.sum()) > 1 and bool((problem.restitution("energy")[closed] < 1.0).any())
+
+
+dissipative_contacts = Region(
+    "several closed contacts, some dissipative (energetic e < 1)", _dissipative
 )

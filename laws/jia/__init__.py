@@ -61,6 +61,7 @@ import numpy as np
 from lawbench.laws.jia.dynamics import SpringImpact, Springs
 
 from lawbench.claims import (
+    ENERGETIC_DISSIPATION,
     FROZEN_CONFIGURATION,
     PAOLI_DISCONTINUITY,
     keeps_energy,
@@ -108,6 +109,7 @@ class Jia(Law):
     findings = (
         PAOLI_DISCONTINUITY,
         FROZEN_CONFIGURATION,
+        ENERGETIC_DISSIPATION,
         Claim(
             "dispersion",
             nonlinear_springs,

@@ -118,6 +118,7 @@ from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 from lawbench import budget
 from lawbench.claims import (
+    ENERGETIC_DISSIPATION,
     FROZEN_CONFIGURATION,
     PAOLI_DISCONTINUITY,
     keeps_energy,
@@ -145,7 +146,7 @@ class LiuZhaoBrogliato(Law):
         "a separating contact receives no impulse unless the others make it approach, "
         "then it is compressed like any other"
     )
-    findings = (PAOLI_DISCONTINUITY, FROZEN_CONFIGURATION)
+    findings = (PAOLI_DISCONTINUITY, FROZEN_CONFIGURATION, ENERGETIC_DISSIPATION)
     guarantees = (
         keeps_energy(
             "Liu, Zhao and Brogliato, Proc. R. Soc. A 464 (2008), eq. (42)",
