@@ -20,6 +20,8 @@ from lawbench.errors import InvalidProblem
 RESTITUTION_KINDS = ("newton", "poisson", "energy")
 # Up to this many coordinates the inverse of M is kept: a product is cheaper than a solve.
 SMALL = 64
+# A matrix with at most this share of non-zero entries is multiplied as a sparse one.
+SPARSE_SHARE = 0.05
 
 
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
@@ -194,10 +196,17 @@ class ImpactProblem:
         asymmetry = np.abs(self.M - self.M.T).max()
         if asymmetry > 1e-12 * np.abs(self.M).max():
             raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
-        try:
-            set_(self, "_cholesky", (np.linalg.cholesky(self.M), True))
-        except np.linalg.LinAlgError:
-            raise InvalidProblem("M is not positive definite") from None
+        diagonal = np.diag(self.M)
+        if self.n > SMALL and not np.count_nonzero(self.M - np.diag(diagonal)):
+            # Bodies that are points or decoupled coordinates: M^-1 is the reciprocal diagonal.
+            if not (diagonal > 0).all():
+                raise InvalidProblem("M is not positive definite")
+            set_(self, "_inverse_diagonal", 1.0 / diagonal)
+        else:
+            try:
+                set_(self, "_cholesky", (np.linalg.cholesky(self.M), True))
+            except np.linalg.LinAlgError:
+                raise InvalidProblem("M is not positive definite") from None
         self._check_normals()
         with np.errstate(over="ignore", invalid="ignore"):
             energy = float(self.v @ self.M @ self.v)
@@ -263,8 +272,12 @@ class ImpactProblem:
         straight down onto the floor), and every law's impulse would be meaningless.
         """
         W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
+        reciprocal = self.__dict__.get("_inverse_diagonal")
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            inverse = _cho_solve(self._cholesky, np.eye(self.n))
+            if reciprocal is not None:
+                inverse = reciprocal[:, None]
+            else:
+                inverse = _cho_solve(self._cholesky, np.eye(self.n))
         if not np.isfinite(inverse).all():
             diagonal = np.diag(self.M)
             raise InvalidProblem(
@@ -276,7 +289,7 @@ class ImpactProblem:
             object.__setattr__(self, "_inverse", inverse)
         # The largest diagonal entry of M^-1 is within a factor n of its largest eigenvalue:
         # scale enough for a test at rounding level.
-        inverse_mass = float(np.diag(inverse).max())
+        inverse_mass = float(inverse.max() if reciprocal is not None else np.diag(inverse).max())
         scale = inverse_mass * float((W**2).sum(axis=0).max())
         normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
         for j in np.flatnonzero(normal <= 1e-12 * scale):
@@ -315,12 +328,28 @@ class ImpactProblem:
         inverse = self.__dict__.get("_inverse")
         if inverse is not None:
             return inverse @ rhs
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None:
+            return reciprocal[:, None] * rhs if np.ndim(rhs) == 2 else reciprocal * rhs
         return _cho_solve(self._cholesky, rhs)
 
     @cached_property
     def delassus(self) -> np.ndarray:
         """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse."""
-        G = self.Wn.T @ self.solve_mass(self.Wn)
+        if self.n > SMALL and np.count_nonzero(self.Wn) <= SPARSE_SHARE * self.Wn.size:
+            # Chains and columns: each contact moves two bodies, so G is banded; the sparse
+            # product costs O(nnz) instead of O(n m^2).
+            import scipy.sparse
+
+            Wn = scipy.sparse.csc_matrix(self.Wn)
+            reciprocal = self.__dict__.get("_inverse_diagonal")
+            if reciprocal is not None:
+                moved = Wn.multiply(reciprocal[:, None]).tocsc()
+            else:
+                moved = scipy.sparse.csc_matrix(self.solve_mass(self.Wn))
+            G = (Wn.T @ moved).toarray()
+        else:
+            G = self.Wn.T @ self.solve_mass(self.Wn)
         G = (G + G.T) / 2
         G.flags.writeable = False
         return G

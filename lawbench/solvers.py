@@ -27,13 +27,17 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 import scipy.sparse
+import scipy.sparse.linalg
 
 from lawbench.errors import SolverFailure
 from lawbench.mechanics import is_diagonal
+from lawbench.problem import SPARSE_SHARE
 
 ROUNDING = 1e-12
 # Contacts up to which active-set enumeration (2**m sets) is the exact, cheap method.
 ENUMERATION_MAX = 6
+# Blocks larger than this with at most SPARSE_SHARE non-zero entries are solved as sparse.
+SPARSE_SIZE = 64
 # Relative violation of z >= 0 and w >= 0 accepted as rounding.
 COMPLEMENTARITY = 1e-10
 
@@ -111,12 +115,7 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
     exact = np.zeros_like(q)
     if active.any():
         try:
-            # An ill-conditioned block (redundant contacts) is fine: the answer is checked below.
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
-                exact[active] = scipy.linalg.solve(
-                    G[np.ix_(active, active)], -q[active], assume_a="pos"
-                )
+            exact[active] = _solve_block(G[np.ix_(active, active)], -q[active])
         except (np.linalg.LinAlgError, ValueError):
             return None
     slack = G @ exact + q
@@ -125,6 +124,25 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
     if exact.min() < -1e-10 * impulse_scale or slack.min() < -1e-10 * velocity_scale:
         return None
     return np.maximum(exact, 0.0)
+
+
+def _solve_block(block: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve a symmetric positive (semi)definite block of a Delassus matrix.
+
+    Sparse LU when it is large and sparse (the banded blocks of chains), a dense solve otherwise.
+
+    An ill-conditioned block (redundant contacts) is fine: the caller checks the answer.
+    """
+    if block.shape[0] > SPARSE_SIZE and np.count_nonzero(block) <= SPARSE_SHARE * block.size:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", scipy.sparse.linalg.MatrixRankWarning)
+            solution = scipy.sparse.linalg.spsolve(scipy.sparse.csc_matrix(block), rhs)
+        if not np.isfinite(solution).all():
+            raise np.linalg.LinAlgError("singular block")
+        return solution
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
+        return scipy.linalg.solve(block, rhs, assume_a="pos")
 
 
 @functools.cache

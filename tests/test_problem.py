@@ -139,3 +139,22 @@ def test_a_contact_no_motion_can_push_along_its_normal_is_refused():
         lawbench.CASES.get("double_pendulum").build(angles=[1e-6, 0.0], omegas=[-1.0, 3.0])
     nearly = lawbench.CASES.get("double_pendulum").build(angles=[1e-3, 0.0], omegas=[-1.0, 3.0])
     assert nearly.delassus[0, 0] > 0
+
+
+def test_a_large_diagonal_mass_gives_the_dense_delassus_matrix():
+    """Chains of more than SMALL balls take the reciprocal diagonal and a sparse product:
+    G = Wn^T M^-1 Wn as the dense computation gives it, and M^-1 rhs likewise."""
+    problem = lawbench.CASES.get("ball_chain").build(n=120, masses=list(np.linspace(1, 3, 120)))
+    M, Wn = problem.M, problem.Wn
+    np.testing.assert_allclose(problem.delassus, Wn.T @ np.linalg.solve(M, Wn), atol=1e-14)
+    rhs = np.arange(120.0)
+    np.testing.assert_allclose(problem.solve_mass(rhs), np.linalg.solve(M, rhs), rtol=1e-14)
+
+
+def test_a_long_plastic_chain_sticks_at_the_momentum_average():
+    """Brogliato 2010, remark after eq. (29): Moreau's law at e = 0 gives every ball of a free
+    chain struck at one end the velocity of the centre of mass; 500 balls take the sparse
+    Delassus product and the sparse exact solve on the active set."""
+    outcome = lawbench.solve("moreau", "ball_chain", n=500, e=0.0)
+    assert outcome.diagnostics["polished"]
+    np.testing.assert_allclose(outcome.v_plus, np.full(500, 1 / 500), atol=1e-12)
