@@ -54,6 +54,7 @@ from lawbench.errors import BudgetExceeded, NotApplicable, SolverFailure
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+from lawbench.roots import crossing
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 
@@ -278,7 +279,7 @@ class _Integration:
             after = self.switches(*self.physical(y_new)[::2])
             crossed = np.flatnonzero(np.sign(before) != np.sign(after))
             if crossed.size:
-                t_new = min(_crossing(partial(self._switch, dense, j), t, t_new) for j in crossed)
+                t_new = min(crossing(partial(self._switch, dense, j), t, t_new) for j in crossed)
                 y_new = dense(t_new)
                 restarts += 1
                 if restarts > options["max_events"]:
@@ -320,21 +321,3 @@ class _Integration:
             forces.append(self.forces(g, un))
             stored.append(self.k * d ** (self.n + 1) / (self.n + 1))
         return {"t": times, "force": np.array(forces), "stored_energy": np.array(stored)}
-
-
-def _crossing(function: Callable[[float], float], lo: float, hi: float) -> float:
-    """The end of a bracket around the first sign change of ``function`` after ``lo``.
-
-    Returns a time just past the change (within rounding), so the state restarted there is on
-    the new branch.
-    """
-    start = np.sign(function(lo))
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid in (lo, hi):
-            break
-        if np.sign(function(mid)) == start:
-            lo = mid
-        else:
-            hi = mid
-    return hi

@@ -179,3 +179,15 @@ def test_bead_column_wall_force_period_matches_falcon():
     al. 1998, as reported in Brogliato 2010)."""
     outcome = lawbench.solve("compliant", "bead_column", {"path": True}, n=10)
     assert wall_force_period(outcome) == pytest.approx(32.4e-6, rel=0.15)
+
+
+def test_event_location_lands_just_past_the_sign_change():
+    """Brent's method to rounding, then the first point on the new side: a state restarted
+    there is on the new branch; a jump (no zero to converge to) is bisected to the same end."""
+    from lawbench.roots import crossing
+
+    smooth = crossing(lambda t: 0.3 - t, 0.0, 1.0)
+    assert smooth > 0.3 and smooth - 0.3 < 1e-15
+    jump = crossing(lambda t: 1.0 if t < 0.7 else -1.0, 0.0, 1.0)
+    assert jump >= 0.7 and jump - 0.7 < 1e-15
+    assert crossing(lambda t: 1.0, 0.0, 1.0) == 1.0

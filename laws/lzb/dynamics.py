@@ -30,11 +30,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.optimize
 
 from lawbench import budget
 from lawbench.errors import BudgetExceeded, SolverFailure
 from lawbench.problem import ImpactProblem
+from lawbench.roots import crossing
 
 IDLE, COMPRESSION, EXPANSION = 0, 1, 2
 # The primary impulse is the independent variable while the primary contact stores at least
@@ -464,17 +464,9 @@ class EnergeticImpact:
 def _crossing(function: Callable[[float], float], lo: float, hi: float) -> float:
     """A point just past the first zero of ``function`` in ``(lo, hi]`` (negative at ``hi``).
 
-    Brent's method to rounding, then the smallest step forward to where the sign has changed,
-    so the state restarted there is on the new branch.
+    ``lo`` itself when the function is already negative there.
     """
-    if function(lo) < 0:
-        return lo
-    root = scipy.optimize.brentq(function, lo, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps)
-    step = np.spacing(max(abs(root), abs(hi - lo)))
-    while root < hi and function(root) >= 0:
-        root = min(root + step, hi)
-        step *= 4
-    return root
+    return lo if function(lo) < 0 else crossing(function, lo, hi)
 
 
 def _box_qp(A: np.ndarray, b: np.ndarray, bound: np.ndarray) -> np.ndarray:
