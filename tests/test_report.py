@@ -215,7 +215,7 @@ def test_a_law_refusing_a_scene_looks_like_a_check_that_does_not_apply(report):
     page = (report / "index.html").read_text()
     refused = re.findall(r'<span class="mark v-refused" title="([^"]*)">([^<]*)</span>', page)
     assert any("NotApplicable" in title and text == "·" for title, text in refused)
-    assert any(title.startswith("friction_cone:") and text == "f·" for title, text in refused)
+    assert any(title.startswith("friction_cone:") and text == "fc·" for title, text in refused)
 
 
 def test_the_headline_counts_the_unexplained_cells_and_lists_each(report):

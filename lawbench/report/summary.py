@@ -23,9 +23,17 @@ ANCHOR, TITLE, VIEWS = "summary", "Summary matrix", ("summary",)
 
 
 def abbreviations(names: list[str]) -> dict[str, str]:
-    """The shortest distinct prefix of each check name."""
+    """One short symbol per check name.
+
+    The initials of its words (``energy_kept``: ``ek``), or, where two names share them, the
+    shortest distinct prefix.
+    """
+    initials = {name: "".join(word[0] for word in name.split("_")) for name in names}
     short = {}
     for name in names:
+        if list(initials.values()).count(initials[name]) == 1:
+            short[name] = initials[name]
+            continue
         length = 1
         while any(o != name and o.startswith(name[:length]) for o in names) and length < len(name):
             length += 1
