@@ -130,8 +130,20 @@ class Case(ABC):
         return values
 
     def build(self, **given: Any) -> ImpactProblem:
-        """Build the impact problem of this scene at the given parameters."""
-        return self._build(self.parameters(**given))
+        """Build the impact problem of this scene at the given parameters.
+
+        Raises
+        ------
+        InvalidProblem
+            For a bad parameter, or parameters whose geometry overflows floating point (the
+            message names the parameters given).
+        """
+        params = self.parameters(**given)
+        try:
+            return self._build(params)
+        except (OverflowError, FloatingPointError) as exc:
+            named = ", ".join(f"{k} = {v!r}" for k, v in given.items()) or "the defaults"
+            raise InvalidProblem(f"{self.name}: {named}: the geometry overflows ({exc})") from None
 
     def _check(self, params: dict[str, Any]) -> None:
         """Check relations between parameters (list lengths); raise `InvalidProblem`."""

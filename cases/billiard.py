@@ -1,0 +1,217 @@
+"""A cue strikes a billiard ball resting on the table: two simultaneous frictional contacts.
+
+Generalized coordinates ``(u, vx, vy, vz, wx, wy, wz)``: the cue's speed ``u`` (m/s) along its
+axis, a rigid stick translating along ``d = (cos(elevation), 0, -sin(elevation))`` (the shot
+goes along +x, tilted down by the elevation); the velocity (m/s) of the ball's centre and its
+angular velocity (rad/s, world frame). The table is the plane ``z = 0``; the ball, a uniform
+solid sphere of radius R (``I = 2 m R^2 / 5``), rests on it with its centre at height R.
+
+Contacts. 1, cue-ball: the cue's axis passes at ``offset_side`` (along y) and ``offset_height``
+(along ``e = (sin(elevation), 0, cos(elevation))``, perpendicular to the cue in the vertical
+plane) from the centre; its tip meets the sphere at ``p = a y + b e - h d`` from the centre
+(``a``, ``b`` the offsets, ``h = sqrt(R^2 - a^2 - b^2)``), where the normal pointing from the
+cue into the ball is ``n = -p / R``. The ball's point moves at ``v + w x p``, the tip at ``u d``,
+so the gap rate is ``n . (v + w x p) - u (d . n)`` and each tangent ``t`` (two unit vectors
+orthogonal to ``n``) gets ``t . (v + w x p) - u (d . t)``: the column is ``(-d . t,
+spatial_column(p, t))``. 2, ball-table: the point ``r = (0, 0, -R)`` with normal ``(0, 0, 1)``
+and tangents x and y: gap rate ``vz``, slip ``(vx - R wy, vy + R wx)``. Before the shot the
+ball is at rest on the table (contact 2 closed, neither approaching nor separating) and the cue
+moves at ``speed``.
+
+Parameters (defaults, a pool table): ball ``mass`` 0.17 kg and ``radius`` 0.028575 m (57.15 mm
+diameter), ``cue_mass`` 0.54 kg, ``speed`` 3 m/s, ``elevation`` 0 degrees, offsets 0 m; per
+contact (cue-ball, ball-table): ``e`` (0.8, 0.5), ``mu`` (0.6, 0.2) (a chalked tip, cloth),
+``stiffness_ratio`` 1 (ball-table over cue-ball) and ``exponent`` 1.5.
+
+Source: Jia, *Energy-based modeling of tangential compliance in 3-dimensional impact* (2012
+talk) and Jia, Mason and Erdmann, IJRR 32(1) (2013): the billiard shot as two simultaneous
+contacts whose normal impulses drive the tangential ones; the masse shot at a steep elevation.
+
+Straight shot: horizontal and through the centre, the cue's normal (x) and the table's (z) are
+orthogonal in the kinetic metric and no contact point slips, so friction cannot act and the
+shot is the frictionless binary impact of the cue on the ball:
+``P = (1 + e1) u m mc / (m + mc)``, ball ``v = P / m`` along x, cue ``u - P / mc``, no spin.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from lawbench.case import CASES, Case, Params, Reference, per_item
+from lawbench.checks import Trial
+from lawbench.errors import InvalidProblem
+from lawbench.problem import Contact, ImpactProblem
+from lawbench.rigid import spatial_column
+from lawbench.spec import Spec
+from lawbench.study import STUDIES, Study
+from lawbench.tags import Tags
+
+TABLE_NORMAL = np.array([0.0, 0.0, 1.0])
+TABLE_TANGENTS = (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+COORDINATES = ["u [m/s]"] + [f"v{a} [m/s]" for a in "xyz"] + [f"w{a} [rad/s]" for a in "xyz"]
+
+
+def cue_geometry(p: Params) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """The cue's geometry at the tip.
+
+    Returns the cue's direction ``d``, the tip's point ``r`` from the centre, the normal ``n``
+    from the cue into the ball and two tangents orthogonal to it.
+    """
+    elevation = math.radians(p["elevation"])
+    d = np.array([math.cos(elevation), 0.0, -math.sin(elevation)])
+    up = np.array([math.sin(elevation), 0.0, math.cos(elevation)])
+    side = np.array([0.0, 1.0, 0.0])
+    a, b, radius = p["offset_side"], p["offset_height"], p["radius"]
+    offset = math.hypot(a, b)
+    h = math.sqrt((radius - offset) * (radius + offset))
+    r = a * side + b * up - h * d
+    n = -r / radius
+    first = np.cross(n, side)
+    first /= np.linalg.norm(first)
+    return d, r, n, (first, np.cross(n, first))
+
+
+def _straight_shot(p: Params) -> np.ndarray:
+    """The frictionless binary impact of the cue on the ball, along x."""
+    m, mc, u = p["mass"], p["cue_mass"], p["speed"]
+    impulse = (1 + p["e"][0]) * u * m * mc / (m + mc)
+    return np.array([u - impulse / mc, impulse / m, 0.0, 0.0, 0.0, 0.0, 0.0])
+
+
+def _straight_condition(p: Params) -> str | None:
+    if p["elevation"] != 0 or p["offset_side"] != 0 or p["offset_height"] != 0:
+        return "needs a horizontal shot through the centre"
+    return None
+
+
+class Billiard(Case):
+    """A cue strikes a ball on the table: cue-ball and ball-table contacts, both frictional."""
+
+    name = "billiard"
+    summary = "cue striking a billiard ball on the table: two frictional contacts (Jia 2013)"
+    params = (
+        Spec("mass", 0.17, "ball mass", "kg", "float", 0.0, low_open=True),
+        Spec("radius", 0.028575, "ball radius", "m", "float", 0.0, low_open=True),
+        Spec("cue_mass", 0.54, "cue mass", "kg", "float", 0.0, low_open=True),
+        Spec("speed", 3.0, "cue speed along its axis", "m/s", "float", 0.0, low_open=True),
+        Spec("elevation", 0.0, "cue elevation above the table", "deg", "float", 0.0, 89.0),
+        Spec("offset_side", 0.0, "sideways offset of the cue's axis (english)", "m", "float"),
+        Spec(
+            "offset_height",
+            0.0,
+            "offset of the cue's axis perpendicular to it, upward (follow > 0, draw < 0)",
+            "m",
+            "float",
+        ),
+        Spec("e", [0.8, 0.5], "restitution, cue-ball then ball-table", "", "floats", 0.0, 1.0),
+        Spec("mu", [0.6, 0.2], "friction, cue-ball then ball-table", "", "floats", 0.0),
+        Spec(
+            "stiffness_ratio",
+            1.0,
+            "stiffness of the ball-table contact over the cue-ball one",
+            "",
+            "float",
+            0.0,
+            low_open=True,
+        ),
+        Spec("exponent", 1.5, "force-indentation exponent", "", "float", 0.0, low_open=True),
+    )
+    requires = Tags(friction=True, several_contacts=True, spatial=True)
+    references = (
+        Reference(
+            "straight shot",
+            "frictionless binary impact of the cue on the ball (friction cannot act)",
+            "moreau",
+            _straight_shot,
+            condition=_straight_condition,
+        ),
+    )
+    examples = {
+        "default": {},
+        "side spin": {"offset_side": 0.01},
+        "masse": {"elevation": 70.0, "offset_side": 0.012, "offset_height": 0.005},
+    }
+
+    def _check(self, params: dict[str, Any]) -> None:
+        for name in ("e", "mu"):
+            per_item(params, name, 2, "contact: cue-ball, ball-table")
+        offset = math.hypot(params["offset_side"], params["offset_height"])
+        if offset >= params["radius"]:
+            raise InvalidProblem(
+                f"offset_side = {params['offset_side']:g} m, offset_height = "
+                f"{params['offset_height']:g} m: the cue's axis misses the ball (offset "
+                f"{offset:g} m >= radius {params['radius']:g} m)"
+            )
+
+    def _build(self, params: dict[str, Any]) -> ImpactProblem:
+        m, radius = params["mass"], params["radius"]
+        inertia = 2 * m * radius * radius / 5
+        d, r, n, tangents = cue_geometry(params)
+        table = np.array([0.0, 0.0, -radius])
+        Wn = np.column_stack(
+            [
+                np.concatenate([[-d @ n], spatial_column(r, n)]),
+                np.concatenate([[0.0], spatial_column(table, TABLE_NORMAL)]),
+            ]
+        )
+        Wt = np.column_stack(
+            [np.concatenate([[-d @ t], spatial_column(r, t)]) for t in tangents]
+            + [np.concatenate([[0.0], spatial_column(table, t)]) for t in TABLE_TANGENTS]
+        )
+        contacts = [
+            Contact(
+                e=params["e"][j],
+                mu=params["mu"][j],
+                stiffness=(1.0, params["stiffness_ratio"])[j],
+                exponent=params["exponent"],
+            )
+            for j in range(2)
+        ]
+        return ImpactProblem(
+            M=np.diag([params["cue_mass"], m, m, m, inertia, inertia, inertia]),
+            Wn=Wn,
+            Wt=Wt,
+            v=np.array([params["speed"], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            contacts=contacts,
+            bodies={"cue": (0,), "ball": tuple(range(1, 7))},
+        )
+
+    def coordinates(self, params: Params) -> list[str]:
+        """The cue's speed, the ball's velocity and angular velocity."""
+        return list(COORDINATES)
+
+
+CASES.register(Billiard())
+
+
+def ball_speed(trial: Trial) -> float:
+    """Speed of the ball's centre after the shot (m/s)."""
+    return float(np.linalg.norm(trial.outcome.v_plus[1:4]))
+
+
+def spin(trial: Trial) -> list[float]:
+    """The ball's angular velocity after the shot (rad/s, world frame)."""
+    return [float(w) for w in trial.outcome.v_plus[4:]]
+
+
+def spin_axis_tilt(trial: Trial) -> float | None:
+    """Angle of the spin axis above the table (degrees); None without spin."""
+    w = trial.outcome.v_plus[4:]
+    size = float(np.linalg.norm(w))
+    return None if size == 0 else math.degrees(math.asin(abs(w[2]) / size))
+
+
+STUDIES.register(
+    Study(
+        name="billiard",
+        title="billiard shot with a side offset of 12 mm: ball speed (m/s), spin (rad/s) and "
+        "the tilt of its axis above the table (degrees) against the cue's elevation",
+        cases=("billiard",),
+        grid={"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]},
+        params={"offset_side": 0.012},
+        measures={"ball_speed": ball_speed, "spin": spin, "spin_tilt": spin_axis_tilt},
+    )
+)

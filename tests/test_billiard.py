@@ -1,0 +1,69 @@
+"""The billiard shot: geometry of the two contacts, the straight shot, the masse shot."""
+
+import math
+
+import numpy as np
+import pytest
+from lawbench.cases.billiard import cue_geometry
+
+import lawbench
+
+CASE = lawbench.CASES.get("billiard")
+
+
+@pytest.mark.parametrize(
+    "shot",
+    [
+        {},
+        {"elevation": 30.0, "offset_side": 0.01},
+        {"elevation": 70.0, "offset_side": -0.012, "offset_height": 0.005},
+    ],
+)
+def test_contact_rates_are_the_velocities_of_the_touching_points(shot):
+    """For any motion (cue speed u, ball v and w), Wn^T and Wt^T give the relative velocity of
+    the touching points along the normals and tangents, computed here point by point."""
+    params = CASE.parameters(**shot)
+    problem = CASE.build(**params)
+    d, r, n, tangents = cue_geometry(params)
+    radius = params["radius"]
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        qdot = rng.normal(size=7)
+        u, v, w = qdot[0], qdot[1:4], qdot[4:]
+        at_cue = v + np.cross(w, r) - u * d
+        at_table = v + np.cross(w, [0.0, 0.0, -radius])
+        expected_n = [at_cue @ n, at_table[2]]
+        expected_t = [at_cue @ t for t in tangents] + [at_table[0], at_table[1]]
+        np.testing.assert_allclose(problem.Wn.T @ qdot, expected_n, atol=1e-14)
+        np.testing.assert_allclose(problem.Wt.T @ qdot, expected_t, atol=1e-14)
+    assert abs(np.linalg.norm(r) - radius) < 1e-15
+    assert problem.un[0] < 0 and problem.un[1] == 0.0
+
+
+def test_the_straight_shot_is_the_frictionless_binary_impact():
+    """Horizontal, through the centre: no contact point slips and the two normals are
+    orthogonal in the kinetic metric, so friction cannot act; the cue's impulse is
+    P = (1 + e) u m mc / (m + mc) (Newton's binary impact), no spin, whatever mu."""
+    params = CASE.parameters()
+    m, mc, u, e = params["mass"], params["cue_mass"], params["speed"], params["e"][0]
+    impulse = (1 + e) * u * m * mc / (m + mc)
+    expected = [u - impulse / mc, impulse / m, 0, 0, 0, 0, 0]
+    for mu in ([0.6, 0.2], [0.0, 0.0]):
+        outcome = lawbench.solve("moreau", "billiard", mu=mu)
+        np.testing.assert_allclose(outcome.v_plus, expected, atol=1e-9)
+
+
+def test_a_masse_shot_spins_the_ball_about_a_tilted_axis():
+    """A steep cue struck off the centre presses the ball into the table: both contacts take
+    friction and the spin axis is neither vertical nor horizontal (Jia 2012, the masse shot)."""
+    outcome = lawbench.solve("moreau", "billiard", **CASE.examples["masse"])
+    w = outcome.v_plus[4:]
+    tilt = math.degrees(math.asin(abs(w[2]) / np.linalg.norm(w)))
+    assert 10.0 < tilt < 80.0
+    assert outcome.Pn[1] > 0 and np.linalg.norm(outcome.Pt[2:]) > 0
+    assert outcome.dT < 0
+
+
+def test_a_cue_that_misses_the_ball_is_refused():
+    with pytest.raises(lawbench.InvalidProblem, match="misses the ball"):
+        CASE.build(offset_side=0.03)
