@@ -213,5 +213,7 @@ STUDIES.register(
         grid={"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]},
         params={"offset_side": 0.012},
         measures={"ball_speed": ball_speed, "spin": spin, "spin_tilt": spin_axis_tilt},
+        axes=("elevation",),
+        view="sweep",
     )
 )

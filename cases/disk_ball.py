@@ -247,7 +247,8 @@ STUDIES.register(
             "primary_contacts": primary_contacts,
         },
         checks=("energy_gain", "admissible", "friction_cone"),
-        axes=("b",),
+        axes=("b", "disk_translation", "disk_rotation", "ball_rebound", "energy_change"),
+        view="sweep",
     )
 )
 STUDIES.register(

@@ -217,3 +217,21 @@ def test_the_study_engine_and_the_report_name_no_law_or_scene():
             if isinstance(node, ast.Constant) and node.value in names and id(node) not in docs
         ]
     assert not hits
+
+
+def test_a_sweep_draws_each_measure_against_its_axis_per_law():
+    """The billiard sweep: one row per answered cell with the elevation and every numeric
+    measure (the spin vector expanded), one panel per measure, one line per law."""
+    from lawbench.report import sweeps
+    from lawbench.runner import Executor, collect
+
+    study = STUDIES.get("billiard")
+    with Executor() as pool:
+        table = collect(study.plan(), pool)
+    frame = sweeps._tidy(table, "elevation", list(study.measures))
+    assert set(frame["law"]) == {"moreau"}
+    assert sorted(frame["elevation"]) == [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]
+    assert {"ball_speed", "spin[0]", "spin[2]", "spin_tilt"} <= set(frame.columns)
+    figure = sweeps._figure("billiard", study.title, frame, "elevation")
+    titles = [ax.get_title() for ax in figure.figure.axes if ax.get_visible()]
+    assert titles == ["ball_speed", "spin[0]", "spin[1]", "spin[2]", "spin_tilt"]

@@ -30,6 +30,7 @@ from lawbench.report import (
     paradoxes,
     stability,
     summary,
+    sweeps,
     tradeoff,
 )
 from lawbench.report.config import Config
@@ -45,6 +46,7 @@ SECTIONS: tuple[ModuleType, ...] = (
     paradoxes,
     dispersion,
     inside,
+    sweeps,
 )
 TITLE = "lawbench: impact laws compared"
 # Seconds to draw one figure in a worker.
