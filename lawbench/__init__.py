@@ -21,6 +21,7 @@ from lawbench.errors import (
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import Contact, ImpactProblem
+from lawbench.runfile import load_run
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim, Region, Verdict
@@ -53,6 +54,7 @@ __all__ = [
     "Trial",
     "Verdict",
     "evaluate",
+    "load_run",
     "run_checks",
     "solve",
     "solve_batch",

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import json
 import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -92,6 +93,26 @@ class RunSpec:
             for number, grid in enumerate(self.grids)
             for job in _expand(grid, self.seed, number)
         ]
+
+    def describe(self) -> str:
+        """The grid as it was read, in one line: names, and each parameter's grid points."""
+        parts = []
+        for number, grid in enumerate(self.grids):
+            text = [f"laws {_listed(grid.get('laws', ['*']))}"]
+            text.append(f"cases {_listed(grid.get('cases', ['*']))}")
+            for kind in ("params", "options"):
+                entries = dict(grid.get(kind, {}))
+                if kind == "options":  # per law: {law: {option: values}}
+                    entries = {f"{law}.{k}": v for law, o in entries.items() for k, v in o.items()}
+                for name, spec in entries.items():
+                    points = values(spec, self.seed, (number, kind, name))
+                    shown = " | ".join(_shown(p) for p in points)
+                    plural = "s" if len(points) != 1 else ""
+                    text.append(f"{name} = {shown} ({len(points)} grid point{plural})")
+            if grid.get("transforms"):
+                text.append(f"transforms {_listed(grid['transforms'])}")
+            parts.append(f"grid {number}: " + "; ".join(text))
+        return " / ".join(parts)
 
     def plan(self) -> Plan:
         """The executor's plan: every row, the checks, their settings; no measures."""
@@ -155,6 +176,59 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
                         ) from None
                     for transform in transforms:
                         yield Job(law_name, case_name, params, options, transform)
+
+
+def _listed(names: Any) -> str:
+    return ",".join(names) if isinstance(names, list) else str(names)
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, list):
+        return "[" + ", ".join(_shown(v) for v in value) + "]"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def parse_values(name: str, text: str) -> list[Any]:
+    """The grid points of a command-line value: ``0,0.5,1`` is three, ``[0.9,0.8]`` one vector.
+
+    Commas outside brackets separate grid points; a bracketed list is one per-contact vector
+    (``[0.9,0.8],[1,1]`` is two). A point is a number where it reads as one, else a word.
+
+    Raises
+    ------
+    InvalidProblem
+        For an empty value, unbalanced brackets or a malformed vector, naming ``name``.
+    """
+    items, depth, current = [], 0, ""
+    for char in text:
+        depth += (char == "[") - (char == "]")
+        if depth < 0:
+            break
+        if char == "," and depth == 0:
+            items.append(current.strip())
+            current = ""
+        else:
+            current += char
+    items.append(current.strip())
+    if depth != 0:
+        raise InvalidProblem(f"--param {name}={text}: unbalanced brackets")
+    if not all(items):
+        raise InvalidProblem(f"--param {name}={text}: an empty value")
+    return [_point(name, item) for item in items]
+
+
+def _point(name: str, item: str) -> Any:
+    try:
+        value = json.loads(item)
+    except json.JSONDecodeError:
+        if item.startswith("["):
+            raise InvalidProblem(f"--param {name}: malformed vector {item}") from None
+        return item
+    if isinstance(value, list) and not all(
+        isinstance(v, int | float) and not isinstance(v, bool) for v in value
+    ):
+        raise InvalidProblem(f"--param {name}: a vector holds numbers, got {item}")
+    return value if isinstance(value, int | float | list) else item
 
 
 def _product(choices: Mapping[str, list[Any]]) -> Iterator[dict[str, Any]]:
