@@ -266,7 +266,7 @@ def _run(args: argparse.Namespace) -> None:
         seconds = estimate_seconds(plan, workers if args.executor != "serial" else 1)
         raise InvalidProblem(
             f"run: a grid of {len(plan.jobs)} cells (more than {LARGE_GRID}), about "
-            f"{seconds / 60:.0f} min on {workers} workers: give --yes to run it"
+            f"{_duration(seconds)} on {workers} workers: give --yes to run it"
         )
     table, computed = run(
         plan,
@@ -286,6 +286,15 @@ def _run(args: argparse.Namespace) -> None:
         return
     failed = int((table["error_class"].fillna("") != "").sum()) if len(table) else 0
     print(f"{len(table)} rows in {out} ({computed} computed now, {failed} failed)")
+
+
+def _duration(seconds: float) -> str:
+    """A duration in the unit a reader expects: seconds, minutes or hours."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 def _inline_spec(args: argparse.Namespace) -> object:

@@ -72,19 +72,29 @@ class RunSpec:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RunSpec:
-        """Build a specification from parsed TOML; unknown keys raise `InvalidProblem`."""
+        """Build a specification from parsed TOML; a bad key or value raises `InvalidProblem`.
+
+        The message names the key (``grid[1].params.e``) and what it should be.
+        """
         unknown = set(data) - {"grid", "seed", "checks", "continuity_sizes"}
         if unknown:
             raise InvalidProblem(f"spec: unknown key {sorted(unknown)[0]!r}")
-        grids = data.get("grid", [])
+        grids = _typed(data.get("grid", []), list, "grid", "an array of [[grid]] tables")
         if not grids:
             raise InvalidProblem("spec: no [[grid]] table")
-        checks = list(data.get("checks", SINGLE_SOLVE))
+        for number, grid in enumerate(grids):
+            _check_grid(grid, number)
+        checks = _strings(data.get("checks", list(SINGLE_SOLVE)), "checks")
         for name in checks:
             if name not in CHECKS:
                 raise InvalidProblem(f"spec: unknown check {name!r}; known: {', '.join(CHECKS)}")
-        sizes = tuple(float(s) for s in data.get("continuity_sizes", (1e-2, 1e-4, 1e-6)))
-        return cls(grids, int(data.get("seed", 0)), checks, sizes)
+        sizes = _typed(data.get("continuity_sizes", [1e-2, 1e-4, 1e-6]), list, "continuity_sizes")
+        if not all(isinstance(x, int | float) and not isinstance(x, bool) for x in sizes):
+            raise InvalidProblem(f"spec: key 'continuity_sizes' holds numbers, got {sizes!r}")
+        seed = data.get("seed", 0)
+        if not isinstance(seed, int) or isinstance(seed, bool):
+            raise InvalidProblem(f"spec: key 'seed' must be an integer, got {seed!r}")
+        return cls(grids, seed, checks, tuple(float(x) for x in sizes))
 
     def rows(self) -> list[Job]:
         """Every row, in order, each checked against its law and case."""
@@ -106,11 +116,18 @@ class RunSpec:
                     entries = {f"{law}.{k}": v for law, o in entries.items() for k, v in o.items()}
                 for name, spec in entries.items():
                     points = values(spec, self.seed, (number, kind, name))
-                    shown = " | ".join(_shown(p) for p in points)
+                    few = (
+                        points
+                        if len(points) <= SHOWN
+                        else [*points[: SHOWN - 1], "...", points[-1]]
+                    )
+                    shown = " | ".join(_shown(p) for p in few)
                     plural = "s" if len(points) != 1 else ""
                     text.append(f"{name} = {shown} ({len(points)} grid point{plural})")
+            if grid.get("examples"):
+                text.append("each case's examples")
             if grid.get("transforms"):
-                text.append(f"transforms {_listed(grid['transforms'])}")
+                text.append(f"transforms {_listed([t or 'none' for t in grid['transforms']])}")
             parts.append(f"grid {number}: " + "; ".join(text))
         return " / ".join(parts)
 
@@ -120,7 +137,41 @@ class RunSpec:
         return Plan("", self.rows(), tuple(self.checks), settings)
 
 
+# Grid points of one parameter the echoed grid shows before it elides the middle ones.
+SHOWN = 6
 GRID_KEYS = {"laws", "cases", "params", "options", "examples", "transforms"}
+_KINDS = {list: "an array", dict: "a table", bool: "true or false", str: "a string"}
+
+
+def _typed(value: Any, kind: type, key: str, what: str | None = None) -> Any:
+    if not isinstance(value, kind):
+        wanted = what or _KINDS.get(kind, kind.__name__)
+        raise InvalidProblem(f"spec: key {key!r} must be {wanted}, got {value!r}")
+    return value
+
+
+def _strings(value: Any, key: str) -> list[str]:
+    """A list of names (one name alone stands for a list of one)."""
+    names = [value] if isinstance(value, str) else _typed(value, list, key)
+    for name in names:
+        _typed(name, str, key, "a string or an array of strings")
+    return names
+
+
+def _check_grid(grid: Any, number: int) -> None:
+    """The keys and value kinds of ``[[grid]]`` table ``number``."""
+    where = f"grid[{number}]"
+    _typed(grid, dict, where, "a table")
+    unknown = set(grid) - GRID_KEYS
+    if unknown:
+        raise InvalidProblem(f"spec {where}: unknown key {sorted(unknown)[0]!r}")
+    for key in ("laws", "cases", "transforms"):
+        if key in grid:
+            _strings(grid[key], f"{where}.{key}")
+    _typed(grid.get("params", {}), dict, f"{where}.params")
+    _typed(grid.get("examples", False), bool, f"{where}.examples")
+    for law, options in _typed(grid.get("options", {}), dict, f"{where}.options").items():
+        _typed(options, dict, f"{where}.options.{law}", "a table of option = values")
 
 
 def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
@@ -135,9 +186,6 @@ def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
 
 
 def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
-    unknown = set(grid) - GRID_KEYS
-    if unknown:
-        raise InvalidProblem(f"spec grid {number}: unknown key {sorted(unknown)[0]!r}")
     every_law = grid.get("laws", ["*"]) in (["*"], "*")
     laws, cases = _names(grid, "laws", LAWS), _names(grid, "cases", CASES)
     param_values = {
@@ -147,7 +195,7 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
     option_grids = dict(grid.get("options", {}))
     for law in option_grids:
         LAWS.get(law)
-    transforms = list(grid.get("transforms", [""]))
+    transforms = _strings(grid.get("transforms", [""]), f"grid[{number}].transforms")
     for spelling in filter(None, transforms):
         parse(spelling)
     for case_name in cases:
@@ -262,5 +310,13 @@ def values(spec: Any, seed: int, where: tuple) -> list[Any]:
                 draws = rng.uniform(low, high, (int(count), size))
             return [row[0] if size == 1 else row for row in draws.tolist()]
     except (TypeError, ValueError) as exc:
-        raise InvalidProblem(f"spec {label}: bad value generator {dict(spec)} ({exc})") from None
-    raise InvalidProblem(f"spec {label}: unknown value generator {dict(spec)}")
+        raise InvalidProblem(
+            f"spec {_key(where)}: bad value generator {dict(spec)} ({exc})"
+        ) from None
+    raise InvalidProblem(f"spec {_key(where)}: unknown value generator {dict(spec)}")
+
+
+def _key(where: tuple) -> str:
+    """The TOML key of a grid entry: ``(0, 'param', 'e')`` is ``grid[0].params.e``."""
+    number, kind, *names = where
+    return f"grid[{number}].{kind}s." + ".".join(str(n) for n in names)
