@@ -30,12 +30,13 @@ from lawbench.verdicts import Claim, Region, Verdict
 __version__ = importlib.metadata.version("lawbench")
 
 # Loaded when first asked for: problem files need scipy.sparse (and h5py for HDF5), fitting
-# needs pandas and scipy.optimize.
+# needs pandas and scipy.optimize, run tables pandas and pyarrow.
 _LAZY = {
     "load_problem": "lawbench.problem_files",
     "save_problem": "lawbench.problem_files",
     "fit": "lawbench.fitting",
     "FitResult": "lawbench.fitting",
+    "load_run": "lawbench.runfile",
 }
 
 
@@ -74,6 +75,7 @@ __all__ = [
     "evaluate",
     "fit",
     "load_problem",
+    "load_run",
     "run_checks",
     "save_problem",
     "solve",

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -42,6 +44,10 @@ EXIT_CODES = {
     CheckFailed: 6,
     LawbenchError: 5,
 }
+
+
+# Cells above which ``lawbench run`` asks for --yes.
+LARGE_GRID = 10_000
 
 
 class _Parser(argparse.ArgumentParser):
@@ -240,56 +246,81 @@ def _study(args: argparse.Namespace) -> None:
 
 def _run(args: argparse.Namespace) -> None:
     from lawbench.grid import RunSpec
-    from lawbench.runner import run
+    from lawbench.runfile import file_format
+    from lawbench.runner import estimate_seconds, run
 
     spec = RunSpec.from_toml(Path(args.spec)) if args.spec else None
     inline = _inline_spec(args)
-    if spec is None and inline is None:
+    if spec is not None and inline is not None:
+        raise InvalidProblem("run: give a spec file or --laws/--cases/--param/--set, not both")
+    spec = spec or inline
+    if spec is None:
         raise InvalidProblem("run: give a spec file or --laws/--cases/--param")
-    spec = inline if spec is None else spec
-    out = Path(args.out or ("results." + args.format))
+    out = Path(args.out or f"results.{args.format or 'parquet'}")
+    file_format(out, args.format)
+    plan = spec.plan()
+    cells = f"{len(plan.jobs)} cell" + ("s" if len(plan.jobs) != 1 else "")
+    print(f"run: {cells}; {spec.describe()}", flush=True)
+    workers = args.workers or os.cpu_count() or 1
+    if len(plan.jobs) > LARGE_GRID and not args.yes and not args.resume:
+        seconds = estimate_seconds(plan, workers if args.executor != "serial" else 1)
+        raise InvalidProblem(
+            f"run: a grid of {len(plan.jobs)} cells (more than {LARGE_GRID}), about "
+            f"{_duration(seconds)} on {workers} workers: give --yes to run it"
+        )
     table, computed = run(
-        spec.plan(),
+        plan,
         out,
         args.executor,
         args.address,
         args.resume,
-        args.format,
         args.chunk_size,
         args.workers,
         args.max_seconds,
+        wait=args.wait,
+        quiet=args.quiet,
+        seed=spec.seed,
     )
+    if args.resume and computed == 0:
+        print(f"{out} is complete: {len(table)} rows, nothing left to compute")
+        return
     failed = int((table["error_class"].fillna("") != "").sum()) if len(table) else 0
     print(f"{len(table)} rows in {out} ({computed} computed now, {failed} failed)")
 
 
-def _inline_spec(args: argparse.Namespace) -> object:
-    from lawbench.grid import RunSpec
+def _duration(seconds: float) -> str:
+    """A duration in the unit a reader expects: seconds, minutes or hours."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
-    if not (args.laws or args.cases or args.param):
+
+def _inline_spec(args: argparse.Namespace) -> object:
+    from lawbench.grid import RunSpec, parse_values
+
+    if not (args.laws or args.cases or args.param or args.set):
         return None
-    params = {}
-    for item in args.param:
-        name, _, text = item.partition("=")
-        if not _ or not name:
-            raise InvalidProblem(f"--param {item!r}: expected NAME=VALUE|VALUE|...")
-        params[name] = [_value(v) for v in text.split("|")]
+    params = {
+        name: parse_values(name, text) for name, text in _assignments(args.param, "--param").items()
+    }
+    laws = args.laws.split(",") if args.laws else ["*"]
+    options: dict[str, dict[str, list]] = {}
+    for name, text in _assignments(args.set, "--set").items():
+        law, dot, option = name.rpartition(".")
+        targets = [law] if dot else laws
+        if targets == ["*"]:
+            raise InvalidProblem(f"--set {name}: name the laws (--laws), or give LAW.{name}")
+        for target in targets:
+            options.setdefault(target, {})[option] = parse_values(name, text)
     grid = {
-        "laws": args.laws.split(",") if args.laws else ["*"],
+        "laws": laws,
         "cases": args.cases.split(",") if args.cases else ["*"],
         "params": params,
+        "options": options,
     }
     return RunSpec.from_dict({"grid": [grid], "seed": args.seed})
-
-
-def _value(text: str) -> object:
-    """A grid value typed on the command line: a number, a comma list, or a word."""
-    parts = [p.strip() for p in text.split(",")]
-    try:
-        numbers = [float(p) for p in parts]
-    except ValueError:
-        return text.strip()
-    return numbers if len(parts) > 1 else numbers[0]
 
 
 def _bench(args: argparse.Namespace) -> None:
@@ -461,7 +492,15 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _executor_arguments(study, "serial")
     study.set_defaults(run=_study)
-    run = commands.add_parser("run", help="run a grid of laws x cases x parameters")
+    run = commands.add_parser(
+        "run",
+        help="run a grid of laws x cases x parameters",
+        description="Run a grid of laws x cases x parameters x options into one tidy table. "
+        "The grid comes from a TOML run file (see README) or from --laws/--cases/--param/--set; "
+        "the first line printed is the grid as read. "
+        "Grid points: --param e=0,0.5,1 is three rows; a per-contact vector: "
+        '--param "e=[0.9,0.8]" is one row.',
+    )
     run.add_argument("spec", nargs="?", help="a TOML run specification")
     run.add_argument("--laws", help="comma-separated laws (default: every law that applies)")
     run.add_argument("--cases", help="comma-separated cases (default: every case)")
@@ -469,15 +508,39 @@ def build_parser() -> argparse.ArgumentParser:
         "--param",
         action="append",
         default=[],
-        metavar="NAME=V1|V2",
-        help="grid values of a case parameter; '|' separates values",
+        metavar="NAME=VALUES",
+        help="a case parameter's grid points: commas separate points (e=0,0.5,1 is three "
+        "rows), brackets make one per-contact vector (e=[0.9,0.8] is one row; "
+        "e=[0.9,0.8],[1,1] two)",
+    )
+    run.add_argument(
+        "--set",
+        "--option",
+        action="append",
+        default=[],
+        metavar="NAME=VALUES",
+        help="a law option for every law of --laws (LAW.NAME for one law), with the grid "
+        "spelling of --param (tol=1e-6,1e-10 is two rows)",
     )
     run.add_argument("--seed", type=int, default=0, help="seed of random samples")
-    run.add_argument("--out", help="output file (default results.parquet)")
-    run.add_argument("--format", choices=("parquet", "csv"), default="parquet")
+    run.add_argument(
+        "--out", help="output file: .parquet, .csv or .feather (default results.parquet)"
+    )
+    run.add_argument(
+        "--format",
+        choices=("parquet", "csv", "feather"),
+        help="the table format; the extension of --out decides, and this must agree",
+    )
     _executor_arguments(run, "processes")
     run.add_argument("--address", help="address of a Dask scheduler (default: a local cluster)")
     run.add_argument("--resume", action="store_true", help="compute only the missing rows")
+    run.add_argument(
+        "--wait", action="store_true", help="wait for another run holding --out's lock to end"
+    )
+    run.add_argument(
+        "--yes", action="store_true", help=f"run a grid of more than {LARGE_GRID} cells"
+    )
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.add_argument("--chunk-size", type=int, default=50, help="rows written per chunk file")
     run.set_defaults(run=_run)
     regress = commands.add_parser("regress", help="compare every law with its baseline")
@@ -540,6 +603,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
+    # The run machinery reports damaged chunks through logging: one line on stderr each.
+    logging.basicConfig(format="lawbench: %(message)s", level=logging.WARNING)
     try:
         args = build_parser().parse_args(argv)
     except SystemExit as exit_:  # usage errors and --help

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import json
 import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -71,19 +72,29 @@ class RunSpec:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RunSpec:
-        """Build a specification from parsed TOML; unknown keys raise `InvalidProblem`."""
+        """Build a specification from parsed TOML; a bad key or value raises `InvalidProblem`.
+
+        The message names the key (``grid[1].params.e``) and what it should be.
+        """
         unknown = set(data) - {"grid", "seed", "checks", "continuity_sizes"}
         if unknown:
             raise InvalidProblem(f"spec: unknown key {sorted(unknown)[0]!r}")
-        grids = data.get("grid", [])
+        grids = _typed(data.get("grid", []), list, "grid", "an array of [[grid]] tables")
         if not grids:
             raise InvalidProblem("spec: no [[grid]] table")
-        checks = list(data.get("checks", SINGLE_SOLVE))
+        for number, grid in enumerate(grids):
+            _check_grid(grid, number)
+        checks = _strings(data.get("checks", list(SINGLE_SOLVE)), "checks")
         for name in checks:
             if name not in CHECKS:
                 raise InvalidProblem(f"spec: unknown check {name!r}; known: {', '.join(CHECKS)}")
-        sizes = tuple(float(s) for s in data.get("continuity_sizes", (1e-2, 1e-4, 1e-6)))
-        return cls(grids, int(data.get("seed", 0)), checks, sizes)
+        sizes = _typed(data.get("continuity_sizes", [1e-2, 1e-4, 1e-6]), list, "continuity_sizes")
+        if not all(isinstance(x, int | float) and not isinstance(x, bool) for x in sizes):
+            raise InvalidProblem(f"spec: key 'continuity_sizes' holds numbers, got {sizes!r}")
+        seed = data.get("seed", 0)
+        if not isinstance(seed, int) or isinstance(seed, bool):
+            raise InvalidProblem(f"spec: key 'seed' must be an integer, got {seed!r}")
+        return cls(grids, seed, checks, tuple(float(x) for x in sizes))
 
     def rows(self) -> list[Job]:
         """Every row, in order, each checked against its law and case."""
@@ -93,13 +104,74 @@ class RunSpec:
             for job in _expand(grid, self.seed, number)
         ]
 
+    def describe(self) -> str:
+        """The grid as it was read, in one line: names, and each parameter's grid points."""
+        parts = []
+        for number, grid in enumerate(self.grids):
+            text = [f"laws {_listed(grid.get('laws', ['*']))}"]
+            text.append(f"cases {_listed(grid.get('cases', ['*']))}")
+            for kind in ("params", "options"):
+                entries = dict(grid.get(kind, {}))
+                if kind == "options":  # per law: {law: {option: values}}
+                    entries = {f"{law}.{k}": v for law, o in entries.items() for k, v in o.items()}
+                for name, spec in entries.items():
+                    points = values(spec, self.seed, (number, kind, name))
+                    few = (
+                        points
+                        if len(points) <= SHOWN
+                        else [*points[: SHOWN - 1], "...", points[-1]]
+                    )
+                    shown = " | ".join(_shown(p) for p in few)
+                    plural = "s" if len(points) != 1 else ""
+                    text.append(f"{name} = {shown} ({len(points)} grid point{plural})")
+            if grid.get("examples"):
+                text.append("each case's examples")
+            if grid.get("transforms"):
+                text.append(f"transforms {_listed([t or 'none' for t in grid['transforms']])}")
+            parts.append(f"grid {number}: " + "; ".join(text))
+        return " / ".join(parts)
+
     def plan(self) -> Plan:
         """The executor's plan: every row, the checks, their settings; no measures."""
         settings = {"continuity_sizes": list(self.continuity_sizes)}
         return Plan("", self.rows(), tuple(self.checks), settings)
 
 
+# Grid points of one parameter the echoed grid shows before it elides the middle ones.
+SHOWN = 6
 GRID_KEYS = {"laws", "cases", "params", "options", "examples", "transforms"}
+_KINDS = {list: "an array", dict: "a table", bool: "true or false", str: "a string"}
+
+
+def _typed(value: Any, kind: type, key: str, what: str | None = None) -> Any:
+    if not isinstance(value, kind):
+        wanted = what or _KINDS.get(kind, kind.__name__)
+        raise InvalidProblem(f"spec: key {key!r} must be {wanted}, got {value!r}")
+    return value
+
+
+def _strings(value: Any, key: str) -> list[str]:
+    """A list of names (one name alone stands for a list of one)."""
+    names = [value] if isinstance(value, str) else _typed(value, list, key)
+    for name in names:
+        _typed(name, str, key, "a string or an array of strings")
+    return names
+
+
+def _check_grid(grid: Any, number: int) -> None:
+    """The keys and value kinds of ``[[grid]]`` table ``number``."""
+    where = f"grid[{number}]"
+    _typed(grid, dict, where, "a table")
+    unknown = set(grid) - GRID_KEYS
+    if unknown:
+        raise InvalidProblem(f"spec {where}: unknown key {sorted(unknown)[0]!r}")
+    for key in ("laws", "cases", "transforms"):
+        if key in grid:
+            _strings(grid[key], f"{where}.{key}")
+    _typed(grid.get("params", {}), dict, f"{where}.params")
+    _typed(grid.get("examples", False), bool, f"{where}.examples")
+    for law, options in _typed(grid.get("options", {}), dict, f"{where}.options").items():
+        _typed(options, dict, f"{where}.options.{law}", "a table of option = values")
 
 
 def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
@@ -114,9 +186,6 @@ def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
 
 
 def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
-    unknown = set(grid) - GRID_KEYS
-    if unknown:
-        raise InvalidProblem(f"spec grid {number}: unknown key {sorted(unknown)[0]!r}")
     every_law = grid.get("laws", ["*"]) in (["*"], "*")
     laws, cases = _names(grid, "laws", LAWS), _names(grid, "cases", CASES)
     param_values = {
@@ -126,7 +195,7 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
     option_grids = dict(grid.get("options", {}))
     for law in option_grids:
         LAWS.get(law)
-    transforms = list(grid.get("transforms", [""]))
+    transforms = _strings(grid.get("transforms", [""]), f"grid[{number}].transforms")
     for spelling in filter(None, transforms):
         parse(spelling)
     for case_name in cases:
@@ -155,6 +224,59 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
                         ) from None
                     for transform in transforms:
                         yield Job(law_name, case_name, params, options, transform)
+
+
+def _listed(names: Any) -> str:
+    return ",".join(names) if isinstance(names, list) else str(names)
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, list):
+        return "[" + ", ".join(_shown(v) for v in value) + "]"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def parse_values(name: str, text: str) -> list[Any]:
+    """The grid points of a command-line value: ``0,0.5,1`` is three, ``[0.9,0.8]`` one vector.
+
+    Commas outside brackets separate grid points; a bracketed list is one per-contact vector
+    (``[0.9,0.8],[1,1]`` is two). A point is a number where it reads as one, else a word.
+
+    Raises
+    ------
+    InvalidProblem
+        For an empty value, unbalanced brackets or a malformed vector, naming ``name``.
+    """
+    items, depth, current = [], 0, ""
+    for char in text:
+        depth += (char == "[") - (char == "]")
+        if depth < 0:
+            break
+        if char == "," and depth == 0:
+            items.append(current.strip())
+            current = ""
+        else:
+            current += char
+    items.append(current.strip())
+    if depth != 0:
+        raise InvalidProblem(f"--param {name}={text}: unbalanced brackets")
+    if not all(items):
+        raise InvalidProblem(f"--param {name}={text}: an empty value")
+    return [_point(name, item) for item in items]
+
+
+def _point(name: str, item: str) -> Any:
+    try:
+        value = json.loads(item)
+    except json.JSONDecodeError:
+        if item.startswith("["):
+            raise InvalidProblem(f"--param {name}: malformed vector {item}") from None
+        return item
+    if isinstance(value, list) and not all(
+        isinstance(v, int | float) and not isinstance(v, bool) for v in value
+    ):
+        raise InvalidProblem(f"--param {name}: a vector holds numbers, got {item}")
+    return value if isinstance(value, int | float | list) else item
 
 
 def _product(choices: Mapping[str, list[Any]]) -> Iterator[dict[str, Any]]:
@@ -188,5 +310,13 @@ def values(spec: Any, seed: int, where: tuple) -> list[Any]:
                 draws = rng.uniform(low, high, (int(count), size))
             return [row[0] if size == 1 else row for row in draws.tolist()]
     except (TypeError, ValueError) as exc:
-        raise InvalidProblem(f"spec {label}: bad value generator {dict(spec)} ({exc})") from None
-    raise InvalidProblem(f"spec {label}: unknown value generator {dict(spec)}")
+        raise InvalidProblem(
+            f"spec {_key(where)}: bad value generator {dict(spec)} ({exc})"
+        ) from None
+    raise InvalidProblem(f"spec {_key(where)}: unknown value generator {dict(spec)}")
+
+
+def _key(where: tuple) -> str:
+    """The TOML key of a grid entry: ``(0, 'param', 'e')`` is ``grid[0].params.e``."""
+    number, kind, *names = where
+    return f"grid[{number}].{kind}s." + ".".join(str(n) for n in names)

@@ -6,7 +6,8 @@ gave no answer (its class and message; for a `BudgetExceeded`, which budget, how
 how long), the command that reproduces it and the exit status that command gives. Per check it
 adds ``NAME_value``, ``NAME_verdict``, ``NAME_finding`` (the index of the deciding finding in the
 law's ``findings``, -1 for none) and ``NAME_detail``; per measure one column of its name.
-Vectors are JSON text, so a table reads the same from Parquet and from CSV.
+Vectors, parameters and options are JSON text in a record; a run's file holds its tidy form
+(`lawbench.runfile.tidy`: a column per parameter, list columns, categorical verdicts).
 """
 
 from __future__ import annotations

@@ -7,11 +7,12 @@ in this process (``serial``), in local worker processes (``processes``) or on a 
 (``dask``), every cell under the same per-job wall-clock guard (`lawbench.guard`): a cell
 stopped there is a *budget* cell naming the ``wall-clock guard`` and its seconds.
 
-`run` writes a plan's records in chunks (Parquet, or CSV on request) into ``OUT.parts/`` as they
-finish, each chunk file written whole before it appears, so a run that is interrupted (Ctrl-C,
+`run` holds a lock on its output and writes a plan's records in checksummed chunks into
+``OUT.parts/`` as they finish (`lawbench.runfile.Store`), so a run that is interrupted (Ctrl-C,
 a killed process) keeps every finished cell, and a resumed run computes only the cells that are
-missing. When every cell is done the chunks are gathered, sorted by cell index, into ``OUT``.
-The table is the same whichever executor ran it, up to the timing columns (``wall_time_s``,
+missing, and those of a damaged chunk. When every cell is done the chunks are gathered, sorted
+by cell index, into ``OUT``'s tidy table (Parquet, CSV or Feather, from the extension). The
+table is the same whichever executor ran it, up to the timing columns (``wall_time_s``,
 ``spent_s``).
 """
 
@@ -23,11 +24,13 @@ import sys
 import time
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
+from tqdm import tqdm
 
 from lawbench.checks import run_checks
 from lawbench.errors import InvalidProblem
@@ -42,6 +45,7 @@ from lawbench.guard import (
     stopped,
 )
 from lawbench.record import Record
+from lawbench.runfile import Store, file_format, metadata
 from lawbench.study import Job, Measure, Plan
 
 
@@ -232,139 +236,113 @@ class Executor:
             )
 
 
-class Store:
-    """The chunk files of a run and the final table."""
-
-    def __init__(self, out: Path, file_format: str) -> None:
-        self.out = Path(out)
-        self.parts = self.out.with_name(self.out.name + ".parts")
-        self.format = file_format
-        self.written = len(list(self.parts.glob("part-*"))) if self.parts.exists() else 0
-
-    def done(self) -> pd.DataFrame:
-        """Every record finished so far (final table and chunk files)."""
-        frames = [self._read(self.out)] if self.out.exists() else []
-        if self.parts.exists():
-            frames += [self._read(path) for path in sorted(self.parts.glob("part-*"))]
-        if not frames:
-            return pd.DataFrame()
-        return pd.concat(frames, ignore_index=True).drop_duplicates("key")
-
-    def write_chunk(self, records: list[dict]) -> None:
-        """Write one chunk whole under a temporary name, then move it in place."""
-        self.parts.mkdir(parents=True, exist_ok=True)
-        path = self.parts / f"part-{self.written:06d}.{self.format}"
-        temporary = path.with_suffix(".tmp")
-        self._write(pd.DataFrame(records), temporary)
-        os.replace(temporary, path)
-        self.written += 1
-
-    def finish(self, total: int) -> pd.DataFrame:
-        """Gather the chunks by cell index; when all ``total`` cells are done, write ``out``."""
-        table = self.done()
-        if not len(table):
-            return table
-        table = table.sort_values("index").reset_index(drop=True)
-        if len(table) == total:
-            self.out.parent.mkdir(parents=True, exist_ok=True)
-            self._write(table, self.out)
-            for path in self.parts.glob("part-*"):
-                path.unlink()
-            if self.parts.exists():
-                self.parts.rmdir()
-        return table
-
-    def _read(self, path: Path) -> pd.DataFrame:
-        if self.format == "parquet":
-            return pd.read_parquet(path)
-        return pd.read_csv(path, keep_default_na=False, na_values=[""])
-
-    def _write(self, table: pd.DataFrame, path: Path) -> None:
-        if self.format == "parquet":
-            table.to_parquet(path, index=False)
-        else:
-            table.to_csv(path, index=False)
-
-
-class Progress:
-    """Cells done, failures and time left, on a terminal only."""
-
-    def __init__(self, total: int, done: int, stream: Any = sys.stderr) -> None:
-        self.total, self.done, self.stream = total, done, stream
-        self.enabled = stream.isatty()
-        self.start = time.monotonic()
-        self.computed = self.failed = 0
-
-    def update(self, row: dict) -> None:
-        """Count a finished cell and redraw the line."""
-        self.done += 1
-        self.computed += 1
-        self.failed += row["error_class"] != ""
-        if not self.enabled:
-            return
-        elapsed = time.monotonic() - self.start
-        left = elapsed / self.computed * (self.total - self.done)
-        self.stream.write(
-            f"\r{self.done}/{self.total} cells, {self.failed} failed, "
-            f"{elapsed:.0f} s elapsed, about {left:.0f} s left "
-        )
-        self.stream.flush()
-
-    def close(self) -> None:
-        """End the line."""
-        if self.enabled:
-            self.stream.write("\n")
+def _progress(total: int, done: int, quiet: bool) -> tqdm:
+    """A progress bar on a terminal's stderr; silent in a pipe and under ``quiet``."""
+    return tqdm(
+        total=total,
+        initial=done,
+        unit="cell",
+        disable=quiet or not sys.stderr.isatty(),
+        dynamic_ncols=True,
+    )
 
 
 def run_many(
     plans: Sequence[tuple[Plan, Path]],
     executor: Executor,
     resume: bool = False,
-    file_format: str = "parquet",
     chunk_size: int = 50,
+    wait: bool = False,
+    quiet: bool = False,
+    seed: int | None = None,
 ) -> list[tuple[pd.DataFrame, int]]:
-    """Run every plan into its file at once, one pool for all.
+    """Run every plan into its file at once, one pool for all, each file locked meanwhile.
 
-    Returns, per plan, its table and the number of cells computed now.
+    Parameters
+    ----------
+    plans : sequence of (Plan, Path)
+        The plans and their output files (format from the extension, `lawbench.runfile`).
+    executor : Executor
+        The pool, entered (``with executor``).
+    resume : bool
+        Keep the rows already in the outputs and compute only the missing ones.
+    chunk_size : int
+        Rows per chunk file.
+    wait : bool
+        Wait for an output locked by another run instead of stopping.
+    quiet : bool
+        No progress bar.
+    seed : int, optional
+        The seed of the plans' random samples, recorded in the files' metadata.
+
+    Returns
+    -------
+    list of (pandas.DataFrame, int)
+        Per plan, its records (`lawbench.record.Record` columns, cell order) and the number of
+        cells computed now.
 
     Raises
     ------
     InvalidProblem
-        For an output that holds results without ``resume``, before any cell is computed.
+        Before any cell is computed: for an output with an unknown extension, one locked by
+        another run (without ``wait``), or one that holds results without ``resume``.
     """
-    stores, tasks, owner = [], [], []
-    for number, (plan, out) in enumerate(plans):
-        store = Store(out, file_format)
-        finished = store.done()
-        if len(finished) and not resume:
-            raise InvalidProblem(f"{out} already holds results: give --resume or another --out")
-        done = set(finished["key"]) if len(finished) else set()
-        for index, job in enumerate(plan.jobs):
-            if job.key not in done:
-                tasks.append(Task(index, job, plan.name, plan.checks, plan.settings, plan.measures))
-                owner.append(number)
-        stores.append(store)
-    total = sum(len(plan.jobs) for plan, _ in plans)
-    progress = Progress(total, total - len(tasks))
-    buffers: list[list[dict]] = [[] for _ in plans]
-    try:
-        for position, row in executor.run(tasks):
-            buffer = buffers[owner[position]]
-            buffer.append(row)
-            progress.update(row)
-            if len(buffer) >= chunk_size:
-                stores[owner[position]].write_chunk(buffer)
-                buffer.clear()
-    finally:
-        progress.close()
-        for store, buffer in zip(stores, buffers, strict=True):
-            if buffer:
-                store.write_chunk(buffer)
-    computed = [owner.count(number) for number in range(len(plans))]
-    return [
-        (store.finish(len(plan.jobs)), count)
-        for store, (plan, _), count in zip(stores, plans, computed, strict=True)
-    ]
+    stores = [Store(out) for _, out in plans]
+    meta = metadata(seed)
+    with ExitStack() as locks:
+        for store in stores:
+            locks.enter_context(store.locked(wait))
+        tasks, owner = [], []
+        for number, ((plan, out), store) in enumerate(zip(plans, stores, strict=True)):
+            finished = store.done()
+            if len(finished) and not resume:
+                raise InvalidProblem(f"{out} already holds results: give --resume or another --out")
+            done = set(finished["key"]) if len(finished) else set()
+            for index, job in enumerate(plan.jobs):
+                if job.key not in done:
+                    task = Task(index, job, plan.name, plan.checks, plan.settings, plan.measures)
+                    tasks.append(task)
+                    owner.append(number)
+        total = sum(len(plan.jobs) for plan, _ in plans)
+        buffers: list[list[dict]] = [[] for _ in plans]
+        with _progress(total, total - len(tasks), quiet) as progress:
+            failed = 0
+            try:
+                for position, row in executor.run(tasks):
+                    buffer = buffers[owner[position]]
+                    buffer.append(row)
+                    failed += row["error_class"] != ""
+                    progress.set_postfix(failed=failed, refresh=False)
+                    progress.update()
+                    if len(buffer) >= chunk_size:
+                        stores[owner[position]].write_chunk(buffer)
+                        buffer.clear()
+            finally:
+                for store, buffer in zip(stores, buffers, strict=True):
+                    if buffer:
+                        store.write_chunk(buffer)
+        computed = [owner.count(number) for number in range(len(plans))]
+        return [
+            (store.finish(len(plan.jobs), meta), count)
+            for store, (plan, _), count in zip(stores, plans, computed, strict=True)
+        ]
+
+
+def estimate_seconds(plan: Plan, workers: int, sample: int = 3) -> float:
+    """Wall time ``plan`` would take on ``workers`` processes, from a few cells timed here.
+
+    The cells timed are spread evenly over the plan; a grid whose cells differ much in cost
+    (a sweep of an accuracy knob) makes this a rough figure.
+    """
+    jobs = plan.jobs
+    if not jobs:
+        return 0.0
+    picked = jobs[:: max(1, len(jobs) // sample)][:sample]
+    start = time.perf_counter()
+    for index, job in enumerate(picked):
+        compute(Task(index, job, plan.name, plan.checks, plan.settings, plan.measures))
+    per_cell = (time.perf_counter() - start) / len(picked)
+    return per_cell * len(jobs) / max(1, workers)
 
 
 def collect(plan: Plan, executor: Executor) -> pd.DataFrame:
@@ -383,19 +361,25 @@ def run(
     executor: str = "serial",
     address: str | None = None,
     resume: bool = False,
-    file_format: str = "parquet",
     chunk_size: int = 50,
     workers: int | None = None,
     budget_s: float = BUDGET_S,
+    wait: bool = False,
+    quiet: bool = False,
+    seed: int | None = None,
 ) -> tuple[pd.DataFrame, int]:
-    """Run ``plan`` and write its table to ``out``; return the table and the cells computed.
+    """Run ``plan`` and write its table to ``out``; return its records and the cells computed.
+
+    The options are those of `Executor` and `run_many`.
 
     Raises
     ------
     InvalidProblem
-        For an unknown executor, an output that exists without ``resume``, or an unreachable
-        Dask address: all before any cell is computed.
+        For an unknown executor or extension, an output locked by another run (without
+        ``wait``), an output that exists without ``resume``, or an unreachable Dask address:
+        all before any cell is computed.
     """
+    file_format(Path(out))
     pool = Executor(executor, workers, budget_s, address, chunk_size)
     with pool:
-        return run_many([(plan, Path(out))], pool, resume, file_format, chunk_size)[0]
+        return run_many([(plan, Path(out))], pool, resume, chunk_size, wait, quiet, seed)[0]

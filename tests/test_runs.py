@@ -11,6 +11,7 @@ import lawbench
 from lawbench.grid import RunSpec, values
 from lawbench.guard import Guard
 from lawbench.record import budget_text
+from lawbench.runfile import untidy
 from lawbench.runner import Executor, Task, compute, run, run_many
 from lawbench.study import Job, Plan
 from lawbench.transforms import apply, parse, spell
@@ -91,8 +92,9 @@ def test_serial_processes_and_dask_give_the_same_table(tmp_path):
     assert len(tables["serial"]) == len(spec.rows())
     pd.testing.assert_frame_equal(without_time(tables["serial"]), without_time(tables["processes"]))
     pd.testing.assert_frame_equal(without_time(tables["serial"]), without_time(tables["dask"]))
-    stored = pd.read_parquet(tmp_path / "serial.parquet")
-    pd.testing.assert_frame_equal(without_time(stored), without_time(tables["serial"]))
+    stored = lawbench.load_run(tmp_path / "serial.parquet")
+    records = untidy(stored, stored.attrs["lawbench"])
+    pd.testing.assert_frame_equal(without_time(records), without_time(tables["serial"]))
 
 
 def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
@@ -108,7 +110,7 @@ def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
             ]
         }
     )
-    table, computed = run(spec.plan(), tmp_path / "out.csv", file_format="csv")
+    table, computed = run(spec.plan(), tmp_path / "out.csv")
     assert computed == 2
     assert list(table["error_class"].fillna("")) == ["BudgetExceeded", ""]
     assert list(table["verdict"]) == ["budget", "holds"]
@@ -150,7 +152,7 @@ def test_the_guard_returns_answers_and_errors_and_stops_a_task_over_its_budget()
 def test_a_cell_stopped_by_the_guard_is_a_budget_cell_naming_it(tmp_path, executor):
     plan = Plan("slow", [SLOW, Job("newton", "ball_chain")])
     start = time.monotonic()
-    table, _ = run(plan, tmp_path / "slow.csv", executor, file_format="csv", budget_s=2.0)
+    table, _ = run(plan, tmp_path / "slow.csv", executor, budget_s=2.0)
     assert time.monotonic() - start < 30
     stopped, answered = table.to_dict("records")
     assert stopped["verdict"] == "budget" and answered["verdict"] == "holds"

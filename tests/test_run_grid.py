@@ -1,0 +1,189 @@
+"""The grid of ``lawbench run`` as typed, its tidy table as pandas reads it, its progress."""
+
+import io
+import json
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+import lawbench
+from lawbench.grid import RunSpec, parse_values
+from lawbench.runner import _progress
+from lawbench.verdicts import Verdict
+
+CHAIN = ["--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial"]
+
+
+def lawbench_cli(*args, cwd):
+    return subprocess.run(
+        [sys.executable, "-m", "lawbench", *args], cwd=cwd, capture_output=True, text=True
+    )
+
+
+@pytest.fixture(scope="module")
+def three(tmp_path_factory):
+    """``--param e=0,0.5,1`` run into Parquet and CSV: the folder and the first run's output."""
+    folder = tmp_path_factory.mktemp("three")
+    for out in ("three.parquet", "three.csv"):
+        done = lawbench_cli("run", *CHAIN, "--param", "e=0,0.5,1", "--out", out, cwd=folder)
+        assert done.returncode == 0, done.stderr
+    return folder, done.stdout
+
+
+def test_commas_give_grid_points_and_the_first_line_says_so(three):
+    folder, stdout = three
+    assert stdout.splitlines()[0] == (
+        "run: 3 cells; grid 0: laws newton; cases three_ball_chain; e = 0 | 0.5 | 1 (3 grid points)"
+    )
+    table = pd.read_parquet(folder / "three.parquet")
+    assert list(table["e"]) == [0.0, 0.5, 1.0]
+
+
+def test_brackets_give_one_per_contact_vector(tmp_path):
+    done = lawbench_cli("run", *CHAIN, "--param", "e=[0.9,0.8]", "--out", "v.parquet", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "e = [0.9, 0.8] (1 grid point)" in done.stdout.splitlines()[0]
+    (e,) = pd.read_parquet(tmp_path / "v.parquet")["e"]
+    assert list(e) == [0.9, 0.8]
+
+
+@pytest.mark.parametrize(
+    ("text", "points"),
+    [
+        ("0,0.5,1", [0, 0.5, 1]),
+        ("[0.9,0.8]", [[0.9, 0.8]]),
+        ("[0.9,0.8], [1,1]", [[0.9, 0.8], [1, 1]]),
+        ("left_to_right,right_to_left", ["left_to_right", "right_to_left"]),
+    ],
+)
+def test_the_grid_spelling(text, points):
+    assert parse_values("e", text) == points
+
+
+@pytest.mark.parametrize(("text", "message"), [("[1,2", "unbalanced"), ("1,,2", "empty")])
+def test_a_bad_grid_spelling_names_the_parameter(text, message):
+    with pytest.raises(lawbench.InvalidProblem, match=f"--param e={re.escape(text)}.*{message}"):
+        parse_values("e", text)
+
+
+def test_run_help_documents_both_spellings():
+    done = lawbench_cli("run", "--help", cwd=".")
+    assert done.returncode == 0
+    text = " ".join(done.stdout.split())
+    assert "e=0,0.5,1 is three rows" in text and "e=[0.9,0.8] is one row" in text
+
+
+def test_python_m_lawbench_help_works():
+    done = lawbench_cli("--help", cwd=".")
+    assert done.returncode == 0 and "usage: lawbench" in done.stdout
+
+
+def test_set_gives_law_options_as_grid_points(tmp_path):
+    args = ["run", "--laws", "moreau", "--cases", "three_ball_chain", "--executor", "serial"]
+    done = lawbench_cli(*args, "--set", "tol=1e-6,1e-10", "--out", "o.parquet", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    options = [json.loads(o) for o in pd.read_parquet(tmp_path / "o.parquet")["options"]]
+    assert options == [{"tol": 1e-6}, {"tol": 1e-10}]
+    bad = lawbench_cli(*args, "--set", "colour=1", "--out", "p.parquet", cwd=tmp_path)
+    assert bad.returncode == 2 and "colour" in bad.stderr
+
+
+def test_a_large_grid_states_its_size_and_needs_yes(tmp_path):
+    (tmp_path / "big.toml").write_text(
+        '[[grid]]\nlaws = ["newton"]\ncases = ["three_ball_chain"]\n'
+        "params = { e = { range = [0, 1, 10001] } }\n"
+    )
+    done = lawbench_cli("run", "big.toml", "--out", "big.parquet", cwd=tmp_path)
+    assert done.returncode == 2
+    assert "a grid of 10001 cells" in done.stderr and "give --yes" in done.stderr
+    assert "0 | 0.0001 | 0.0002 | 0.0003 | 0.0004 | ... | 1 (10001 grid points)" in done.stdout
+    assert not (tmp_path / "big.parquet").exists()
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ({"grid": {"laws": ["newton"]}}, "key 'grid' must be an array of"),
+        ({"grid": [{"laws": 3}]}, "key 'grid\\[0\\].laws' must be an array"),
+        ({"grid": [{}, {"params": [1, 2]}]}, "key 'grid\\[1\\].params' must be a table"),
+        ({"grid": [{"options": {"moreau": 1}}]}, "key 'grid\\[0\\].options.moreau'"),
+        ({"grid": [{"examples": "yes"}]}, "key 'grid\\[0\\].examples' must be true or false"),
+        ({"grid": [{}], "seed": "zero"}, "key 'seed' must be an integer"),
+        ({"grid": [{"params": {"e": {"range": [0, 1]}}}]}, "grid\\[0\\].params.e: bad value"),
+    ],
+)
+def test_a_bad_run_file_names_the_key(spec, message):
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        RunSpec.from_dict(spec).rows()
+
+
+def test_the_run_file_of_the_readme_is_valid():
+    readme = (Path(__file__).parents[1] / "README.md").read_text()
+    text = readme.split("```toml\n", 1)[1].split("```", 1)[0]
+    spec = RunSpec.from_dict(tomllib.loads(text))
+    assert len(spec.rows()) > 12
+    assert "e = 0 | 0.5 | 1 (3 grid points)" in spec.describe()
+
+
+# The tidy table.
+
+
+def test_pandas_reads_numbers_lists_and_categorical_verdicts(three):
+    folder, _ = three
+    table = pd.read_parquet(folder / "three.parquet")
+    assert table["e"].dtype == float
+    assert len(table[table.e == 0.5]) == 1
+    assert list(table[table.e == 0.5]["v_plus"].iloc[0]) == pytest.approx([0.0, 0.5, 0.5])
+    assert isinstance(table["verdict"].dtype, pd.CategoricalDtype)
+    assert list(table["verdict"].cat.categories) == [str(v) for v in Verdict]
+    schema = pq.read_schema(folder / "three.parquet")
+    assert str(schema.field("v_plus").type) == "list<element: double>"
+    assert str(schema.field("Pn").type) == "list<element: double>"
+    meta = json.loads(schema.metadata[b"lawbench"])
+    assert set(meta["versions"]) >= {"lawbench", "numpy", "scipy", "clarabel"}
+    assert {"git_commit", "machine", "seed", "started"} <= set(meta)
+
+
+def test_csv_expands_vectors_and_load_run_gathers_them(three):
+    folder, _ = three
+    raw = pd.read_csv(folder / "three.csv")
+    assert {"v_plus_0", "v_plus_1", "v_plus_2", "Pn_0", "Pn_1"} <= set(raw.columns)
+    meta = json.loads((folder / "three.csv.meta.json").read_text())
+    assert meta["versions"]["lawbench"] == lawbench.__version__
+    from_csv = lawbench.load_run(folder / "three.csv")
+    from_parquet = lawbench.load_run(folder / "three.parquet")
+    assert [list(v) for v in from_csv["v_plus"]] == [list(v) for v in from_parquet["v_plus"]]
+    assert list(from_csv["e"]) == [0.0, 0.5, 1.0]
+    assert from_csv["verdict"].dtype == from_parquet["verdict"].dtype
+
+
+def test_load_run_of_a_missing_file_is_invalid(tmp_path):
+    with pytest.raises(lawbench.InvalidProblem, match="does not exist"):
+        lawbench.load_run(tmp_path / "none.parquet")
+
+
+# Progress.
+
+
+def test_progress_shows_on_a_terminal_only(monkeypatch):
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    assert not _progress(10, 0, quiet=False).disable
+    assert _progress(10, 0, quiet=True).disable
+    monkeypatch.setattr(sys, "stderr", io.StringIO())
+    assert _progress(10, 0, quiet=False).disable
+
+
+def test_a_run_in_a_pipe_prints_no_progress(three):
+    folder, _ = three
+    done = lawbench_cli("run", *CHAIN, "--param", "e=0.2", "--out", "p.parquet", cwd=folder)
+    assert done.returncode == 0 and done.stderr == ""
