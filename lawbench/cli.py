@@ -300,18 +300,18 @@ def _duration(seconds: float) -> str:
 def _inline_spec(args: argparse.Namespace) -> object:
     from lawbench.grid import RunSpec, parse_values
 
-    if not (args.laws or args.cases or args.param or args.set):
+    if not (args.laws or args.cases or args.param or args.option):
         return None
     params = {
         name: parse_values(name, text) for name, text in _assignments(args.param, "--param").items()
     }
     laws = args.laws.split(",") if args.laws else ["*"]
     options: dict[str, dict[str, list]] = {}
-    for name, text in _assignments(args.set, "--set").items():
+    for name, text in _assignments(args.option, "--option").items():
         law, dot, option = name.rpartition(".")
         targets = [law] if dot else laws
         if targets == ["*"]:
-            raise InvalidProblem(f"--set {name}: name the laws (--laws), or give LAW.{name}")
+            raise InvalidProblem(f"--option {name}: name the laws (--laws), or give LAW.{name}")
         for target in targets:
             options.setdefault(target, {})[option] = parse_values(name, text)
     grid = {
@@ -506,15 +506,15 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--cases", help="comma-separated cases (default: every case)")
     run.add_argument(
         "--param",
+        "--set",
         action="append",
         default=[],
         metavar="NAME=VALUES",
-        help="a case parameter's grid points: commas separate points (e=0,0.5,1 is three "
-        "rows), brackets make one per-contact vector (e=[0.9,0.8] is one row; "
-        "e=[0.9,0.8],[1,1] two)",
+        help="a case parameter's grid points (--set as in solve): commas separate points "
+        "(e=0,0.5,1 is three rows), brackets make one per-contact vector (e=[0.9,0.8] is one "
+        "row; e=[0.9,0.8],[1,1] two)",
     )
     run.add_argument(
-        "--set",
         "--option",
         action="append",
         default=[],

@@ -84,14 +84,17 @@ def test_python_m_lawbench_help_works():
     assert done.returncode == 0 and "usage: lawbench" in done.stdout
 
 
-def test_set_gives_law_options_as_grid_points(tmp_path):
+def test_option_gives_law_options_as_grid_points_and_set_scene_parameters(tmp_path):
     args = ["run", "--laws", "moreau", "--cases", "three_ball_chain", "--executor", "serial"]
-    done = lawbench_cli(*args, "--set", "tol=1e-6,1e-10", "--out", "o.parquet", cwd=tmp_path)
+    done = lawbench_cli(*args, "--option", "tol=1e-6,1e-10", "--out", "o.parquet", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     options = [json.loads(o) for o in pd.read_parquet(tmp_path / "o.parquet")["options"]]
     assert options == [{"tol": 1e-6}, {"tol": 1e-10}]
-    bad = lawbench_cli(*args, "--set", "colour=1", "--out", "p.parquet", cwd=tmp_path)
+    bad = lawbench_cli(*args, "--option", "colour=1", "--out", "p.parquet", cwd=tmp_path)
     assert bad.returncode == 2 and "colour" in bad.stderr
+    scene = lawbench_cli(*args, "--set", "e=0,1", "--out", "s.parquet", cwd=tmp_path)
+    assert scene.returncode == 0, scene.stderr
+    assert sorted(pd.read_parquet(tmp_path / "s.parquet")["e"]) == [0.0, 1.0]
 
 
 def test_a_large_grid_states_its_size_and_needs_yes(tmp_path):
