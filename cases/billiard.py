@@ -187,6 +187,11 @@ class Billiard(Case):
 CASES.register(Billiard())
 
 
+def ball_velocity(trial: Trial) -> list[float]:
+    """The velocity of the ball's centre after the shot (m/s, world frame)."""
+    return [float(v) for v in trial.outcome.v_plus[1:4]]
+
+
 def ball_speed(trial: Trial) -> float:
     """Speed of the ball's centre after the shot (m/s)."""
     return float(np.linalg.norm(trial.outcome.v_plus[1:4]))
@@ -204,16 +209,41 @@ def spin_axis_tilt(trial: Trial) -> float | None:
     return None if size == 0 else math.degrees(math.asin(abs(w[2]) / size))
 
 
+MEASURES = {
+    "velocity": ball_velocity,
+    "ball_speed": ball_speed,
+    "spin": spin,
+    "spin_tilt": spin_axis_tilt,
+}
+UNITS = {"velocity": "m/s", "ball_speed": "m/s", "spin": "rad/s", "spin_tilt": "deg"}
+
 STUDIES.register(
     Study(
         name="billiard",
-        title="billiard shot with a side offset of 12 mm: ball speed (m/s), spin (rad/s) and "
-        "the tilt of its axis above the table (degrees) against the cue's elevation",
+        title="billiard shot with a side offset of 12 mm: the ball's velocity (vx, vy, vz; m/s), "
+        "speed (m/s), spin (wx, wy, wz; rad/s) and the tilt of its spin axis above the table "
+        "(degrees) against the cue's elevation (degrees)",
         cases=("billiard",),
         grid={"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]},
         params={"offset_side": 0.012},
-        measures={"ball_speed": ball_speed, "spin": spin, "spin_tilt": spin_axis_tilt},
+        measures=MEASURES,
         axes=("elevation",),
+        units=UNITS,
+        view="sweep",
+    )
+)
+STUDIES.register(
+    Study(
+        name="billiard_offset",
+        title="masse shot at 60 degrees of elevation: the ball's velocity (m/s), speed (m/s), "
+        "spin (rad/s) and spin-axis tilt (degrees) against the cue's sideways offset (m), "
+        "-12 mm (left english) to 12 mm",
+        cases=("billiard",),
+        grid={"offset_side": [-0.012, -0.006, 0.0, 0.006, 0.012]},
+        params={"elevation": 60.0},
+        measures=MEASURES,
+        axes=("offset_side",),
+        units=UNITS,
         view="sweep",
     )
 )

@@ -248,6 +248,9 @@ STUDIES.register(
         },
         checks=("energy_gain", "admissible", "friction_cone"),
         axes=("b", "disk_translation", "disk_rotation", "ball_rebound", "energy_change"),
+        units=dict.fromkeys(
+            ("disk_translation", "disk_rotation", "ball_rebound", "energy_change"), ""
+        ),
         view="sweep",
     )
 )

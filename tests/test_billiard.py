@@ -67,3 +67,13 @@ def test_a_masse_shot_spins_the_ball_about_a_tilted_axis():
 def test_a_cue_that_misses_the_ball_is_refused():
     with pytest.raises(lawbench.InvalidProblem, match="misses the ball"):
         CASE.build(offset_side=0.03)
+
+
+def test_mirrored_offsets_give_mirrored_shots():
+    """Reflecting the shot in the vertical plane of the cue (y -> -y) reflects the outcome: the
+    ball's vy and the spin components wx, wz (a pseudovector) change sign, the rest stays."""
+    mirror = np.array([1, 1, -1, 1, -1, 1, -1])
+    for elevation in (0.0, 60.0):
+        left = lawbench.solve("moreau", "billiard", elevation=elevation, offset_side=-0.01)
+        right = lawbench.solve("moreau", "billiard", elevation=elevation, offset_side=0.01)
+        np.testing.assert_allclose(left.v_plus, mirror * right.v_plus, atol=1e-7)
