@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import dataclasses
 import math
 import subprocess
 import sys
@@ -254,3 +255,20 @@ def test_every_sweep_states_the_unit_of_what_it_draws():
         assert set(drawn) <= set(study.units), study.name
         case = lawbench.CASES.get(study.case_names()[0])
         assert study.axes[0] in {spec.name for spec in case.params}, study.name
+
+
+def test_a_sweep_over_decades_draws_a_log_abscissa():
+    """ping_pong over k2/k1 from 1/10 to 10: a log abscissa, dimensionless rebound ratios."""
+    from lawbench.report import sweeps
+    from lawbench.runner import Executor, collect
+
+    study = STUDIES.get("ping_pong").with_params({}).preset("quick")
+    study = dataclasses.replace(study, laws=("sequential",))
+    with Executor() as pool:
+        table = collect(study.plan(), pool)
+    frame = sweeps._tidy(table, "stiffness_ratio", list(study.measures))
+    units = {**study.units, "stiffness_ratio": ""}
+    figure = sweeps._figure("ping_pong", study.title, frame, "stiffness_ratio", units)
+    shown = [ax for ax in figure.figure.axes if ax.get_visible()]
+    assert {ax.get_xscale() for ax in shown} == {"log"}
+    assert [ax.get_ylabel() for ax in shown] == ["v1_over_v0 [-]", "v2_over_v0 [-]"]

@@ -4,7 +4,8 @@ A view of the studies declared with ``view="sweep"``: the study's first axis (a 
 is the abscissa, and each of the measures its other axes name (every measure when it names
 none) is drawn against it, one line per law, one panel per
 measure (a vector measure gives one panel per component); the table lists every cell with its
-verdict. The abscissa takes the unit of the scene's parameter, each panel the unit the study
+verdict. An abscissa over two decades or more (a stiffness ratio) is drawn on a log scale.
+The abscissa takes the unit of the scene's parameter, each panel the unit the study
 declares for its measure (``Study.units``): one panel holds one quantity, so quantities of
 different units (m/s, rad/s) never share an axis.
 """
@@ -80,6 +81,12 @@ def unit_label(name: str, units: Mapping[str, str]) -> str:
     return f"{name} [{unit or '-'}]"
 
 
+def _decades(values: pd.Series) -> float:
+    """Decades a positive abscissa spans (0 when it reaches zero or below): a log axis from 2."""
+    low, high = float(values.min()), float(values.max())
+    return float(np.log10(high / low)) if low > 0 else 0.0
+
+
 def _number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
@@ -99,6 +106,8 @@ def _figure(
         for law, group in frame.groupby("law", sort=True):
             ordered = group.sort_values(axis)
             ax.plot(ordered[axis], ordered[column], **plots.law_style(str(law)))
+        if _decades(frame[axis]) >= 2:
+            ax.set_xscale("log")
         ax.set_xlabel(unit_label(axis, units))
         ax.set_ylabel(unit_label(column, units))
         ax.set_title(column)
