@@ -238,11 +238,12 @@ def test_a_sweep_draws_each_measure_against_its_axis_per_law():
     shown = [ax for ax in figure.figure.axes if ax.get_visible()]
     velocity = [f"velocity[{k}]" for k in range(3)]
     spin = [f"spin[{k}]" for k in range(3)]
-    assert [ax.get_title() for ax in shown] == [*velocity, "ball_speed", *spin, "spin_tilt"]
+    titles = [*velocity, "ball_speed", *spin, "spin_tilt", "curvature"]
+    assert [ax.get_title() for ax in shown] == titles
     assert {ax.get_xlabel() for ax in shown} == {"elevation [deg]"}
     ylabels = [ax.get_ylabel() for ax in shown]
     assert ylabels[:4] == [f"{c} [m/s]" for c in [*velocity, "ball_speed"]]
-    assert ylabels[4:] == [f"{c} [rad/s]" for c in spin] + ["spin_tilt [deg]"]
+    assert ylabels[4:] == [f"{c} [rad/s]" for c in spin] + ["spin_tilt [deg]", "curvature [1/m]"]
 
 
 def test_every_sweep_states_the_unit_of_what_it_draws():
