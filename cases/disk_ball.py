@@ -257,13 +257,13 @@ STUDIES.register(
 STUDIES.register(
     impact_paths(
         "disk_ball_energies",
-        "disk struck low, at the centre and high (b = -4, 0, 4 cm): the energetic law's "
+        "disk struck low, at the centre and high (b = -4.5, 0, 4.5 cm): the energetic law's "
         "stored energy per contact along the impact (contacts 0-2 the floor points A, B, C; "
         "3 the ball D) and its primary contacts",
         "lzb",
         "disk_ball",
         "b",
-        [-0.04, 0.0, 0.04],
+        [-0.045, 0.0, 0.045],
         ("stored_energy",),
         {"stored_energy_peaks": stored_energy_peaks, "primary_contacts": primary_contacts},
     )

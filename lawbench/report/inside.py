@@ -151,6 +151,9 @@ def _along(case: Case, study: Study, table: pd.DataFrame) -> Figure:
             for ax in axes[:, col]:
                 ax.set_axis_off()
             continue
+        measured = _measured(row, [name for name in study.measures if name != "path"])
+        if measured:
+            notes.append(f"{heading}: {measured}")
         path = found["path"]
         x_key = next(iter(path))
         x_name, x_unit = QUANTITIES.get(x_key, (x_key, "unit not stated"))
@@ -183,6 +186,18 @@ def _along(case: Case, study: Study, table: pd.DataFrame) -> Figure:
         caption += " " + "; ".join(notes) + "."
     frame = pd.concat(data, ignore_index=True) if data else pd.DataFrame()
     return Figure(f"inside_{study.name}", caption, fig, frame)
+
+
+def _measured(row: dict[str, Any], names: list[str]) -> str:
+    """``name = value`` of a cell's other measures (numbers to three figures)."""
+    shown = []
+    for name in names:
+        value = parsed(row.get(name))
+        if isinstance(value, list) and all(isinstance(v, int | float) for v in value):
+            shown.append(f"{name} = [{', '.join(f'{v:.3g}' for v in value)}]")
+        elif isinstance(value, int | float) and not isinstance(value, bool):
+            shown.append(f"{name} = {value:.3g}")
+    return ", ".join(shown)
 
 
 def _spread(ax: Any, values: np.ndarray) -> None:
