@@ -51,6 +51,9 @@ from lawbench.tags import Tags
 
 TABLE_NORMAL = np.array([0.0, 0.0, 1.0])
 TABLE_TANGENTS = (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+GRAVITY = 9.81  # m/s^2
+# Relative size below which a vertical velocity or a slip counts as none.
+TOUCHING = 1e-9
 COORDINATES = ["u [m/s]"] + [f"v{a} [m/s]" for a in "xyz"] + [f"w{a} [rad/s]" for a in "xyz"]
 
 
@@ -187,6 +190,11 @@ class Billiard(Case):
 CASES.register(Billiard())
 
 
+def ball_velocity(trial: Trial) -> list[float]:
+    """The velocity of the ball's centre after the shot (m/s, world frame)."""
+    return [float(v) for v in trial.outcome.v_plus[1:4]]
+
+
 def ball_speed(trial: Trial) -> float:
     """Speed of the ball's centre after the shot (m/s)."""
     return float(np.linalg.norm(trial.outcome.v_plus[1:4]))
@@ -204,16 +212,70 @@ def spin_axis_tilt(trial: Trial) -> float | None:
     return None if size == 0 else math.degrees(math.asin(abs(w[2]) / size))
 
 
+def path_curvature(trial: Trial) -> float | None:
+    """Curvature of the ball's path on the table just after the shot (1/m), > 0 turning left.
+
+    The ball slides on the cloth: friction ``mu2 m g`` (``mu2`` the ball-table coefficient,
+    ``g`` = 9.81 m/s^2) opposes the slip ``s = (vx - R wy, vy + R wx)`` of its contact point,
+    a horizontal acceleration ``a = -mu2 g s / |s|``, and the path bends with curvature
+    ``(v x a)_z / |v|^3``. Spin about the vertical (english) keeps ``s`` along ``v`` and the
+    path straight; a spin axis tilted out of the plane of the shot (masse) curves it. None
+    when the ball leaves the table (``vz > 0``), stands still or rolls without slipping.
+    """
+    v, w = trial.outcome.v_plus[1:4], trial.outcome.v_plus[4:]
+    radius, mu = trial.params["radius"], trial.params["mu"][1]
+    speed = math.hypot(v[0], v[1])
+    slip = np.array([v[0] - radius * w[1], v[1] + radius * w[0]])
+    size = float(np.linalg.norm(slip))
+    if v[2] > TOUCHING * speed or speed == 0 or size <= TOUCHING * speed:
+        return None
+    a = -mu * GRAVITY * slip / size
+    return float((v[0] * a[1] - v[1] * a[0]) / speed**3)
+
+
+MEASURES = {
+    "velocity": ball_velocity,
+    "ball_speed": ball_speed,
+    "spin": spin,
+    "spin_tilt": spin_axis_tilt,
+    "curvature": path_curvature,
+}
+UNITS = {
+    "velocity": "m/s",
+    "ball_speed": "m/s",
+    "spin": "rad/s",
+    "spin_tilt": "deg",
+    "curvature": "1/m",
+}
+
 STUDIES.register(
     Study(
         name="billiard",
-        title="billiard shot with a side offset of 12 mm: ball speed (m/s), spin (rad/s) and "
-        "the tilt of its axis above the table (degrees) against the cue's elevation",
+        title="billiard shot with a side offset of 12 mm: the ball's velocity (vx, vy, vz; m/s), "
+        "speed (m/s), spin (wx, wy, wz; rad/s) and the tilt of its spin axis above the table "
+        "(degrees) and the curvature of its path on the cloth (1/m) against the cue's elevation "
+        "(degrees)",
         cases=("billiard",),
         grid={"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]},
         params={"offset_side": 0.012},
-        measures={"ball_speed": ball_speed, "spin": spin, "spin_tilt": spin_axis_tilt},
+        measures=MEASURES,
         axes=("elevation",),
+        units=UNITS,
+        view="sweep",
+    )
+)
+STUDIES.register(
+    Study(
+        name="billiard_offset",
+        title="masse shot at 60 degrees of elevation: the ball's velocity (m/s), speed (m/s), "
+        "spin (rad/s), spin-axis tilt (degrees) and path curvature (1/m) against the cue's "
+        "sideways offset (m), -12 mm (left english) to 12 mm",
+        cases=("billiard",),
+        grid={"offset_side": [-0.012, -0.006, 0.0, 0.006, 0.012]},
+        params={"elevation": 60.0},
+        measures=MEASURES,
+        axes=("offset_side",),
+        units=UNITS,
         view="sweep",
     )
 )

@@ -49,12 +49,12 @@ from typing import Any
 
 import numpy as np
 
-from lawbench import measures
 from lawbench.case import CASES, Case, GroundTruth, Params, per_item
 from lawbench.errors import InvalidProblem
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
 from lawbench.study import STUDIES, Study
+from lawbench.study_shapes import impact_paths
 from lawbench.tags import Tags
 
 CONTACTS = ("A", "B", "C", "D")
@@ -248,24 +248,23 @@ STUDIES.register(
         },
         checks=("energy_gain", "admissible", "friction_cone"),
         axes=("b", "disk_translation", "disk_rotation", "ball_rebound", "energy_change"),
+        units=dict.fromkeys(
+            ("disk_translation", "disk_rotation", "ball_rebound", "energy_change"), ""
+        ),
         view="sweep",
     )
 )
 STUDIES.register(
-    Study(
-        name="disk_ball_energies",
-        title="disk struck low, at the centre and high (b = -4, 0, 4 cm): the energetic law's "
-        "stored energy per contact along the impact (path) and its primary contacts",
-        cases=("disk_ball",),
-        laws=("lzb",),
-        grid={"b": [-0.04, 0.0, 0.04]},
-        options={"lzb": {"path": [True]}},
-        measures={
-            "path": measures.impact_path,
-            "stored_energy_peaks": stored_energy_peaks,
-            "primary_contacts": primary_contacts,
-        },
-        checks=("energy_gain",),
-        axes=("b",),
+    impact_paths(
+        "disk_ball_energies",
+        "disk struck low, at the centre and high (b = -4.5, 0, 4.5 cm): the energetic law's "
+        "stored energy per contact along the impact (contacts 0-2 the floor points A, B, C; "
+        "3 the ball D) and its primary contacts",
+        "lzb",
+        "disk_ball",
+        "b",
+        [-0.045, 0.0, 0.045],
+        ("stored_energy",),
+        {"stored_energy_peaks": stored_energy_peaks, "primary_contacts": primary_contacts},
     )
 )

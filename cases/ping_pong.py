@@ -140,6 +140,7 @@ STUDIES.register(
         measures={"v1_over_v0": rebound_ratio_1, "v2_over_v0": rebound_ratio_2},
         checks=("energy_gain", "admissible"),
         axes=("stiffness_ratio",),
+        units={"v1_over_v0": "", "v2_over_v0": ""},
         view="sweep",
     )
 )

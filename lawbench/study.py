@@ -225,6 +225,9 @@ class Study:
         Solves per cell (timing studies keep the median).
     axes : tuple of str
         The columns a view draws along: a grid parameter, ``transform_value`` or a measure.
+    units : mapping
+        Measure (or quantity a view draws) -> its unit ('' for dimensionless); views label
+        their axes with it (a grid parameter takes the unit of its scene's `Spec`).
     view : str or None
         The report section that shows the study (``lawbench.report``), None for none.
     slow : bool
@@ -248,6 +251,7 @@ class Study:
     settings: Mapping[str, Any] = field(default_factory=dict)
     repeats: int = 1
     axes: tuple[str, ...] = ()
+    units: Mapping[str, str] = field(default_factory=dict)
     view: str | None = None
     slow: bool = False
     full: Mapping[str, Any] = field(default_factory=dict)

@@ -218,6 +218,35 @@ def impact_path(law: str, case: str, title: str, params: Mapping[str, Any] | Non
     )
 
 
+def impact_paths(
+    name: str,
+    title: str,
+    law: str,
+    case: str,
+    axis: str,
+    values: Sequence[Any],
+    quantities: Sequence[str],
+    extra: Mapping[str, Measure] | None = None,
+) -> Study:
+    """``law`` on ``case`` at each of ``values`` of the parameter ``axis`` (option ``path``).
+
+    The report draws the path's ``quantities`` (keys of `lawbench.outcome.Outcome.path`) of
+    every cell side by side; ``extra`` measures join the table.
+    """
+    return Study(
+        name=name,
+        title=title,
+        cases=(case,),
+        laws=(law,),
+        grid={axis: list(values)},
+        options={law: {"path": [True]}},
+        measures={"path": measures.impact_path, **dict(extra or {})},
+        checks=("energy_gain",),
+        axes=(axis, *quantities),
+        view="inside",
+    )
+
+
 STUDIES.register(
     Study(
         name="summary",

@@ -67,3 +67,35 @@ def test_a_masse_shot_spins_the_ball_about_a_tilted_axis():
 def test_a_cue_that_misses_the_ball_is_refused():
     with pytest.raises(lawbench.InvalidProblem, match="misses the ball"):
         CASE.build(offset_side=0.03)
+
+
+def test_mirrored_offsets_give_mirrored_shots():
+    """Reflecting the shot in the vertical plane of the cue (y -> -y) reflects the outcome: the
+    ball's vy and the spin components wx, wz (a pseudovector) change sign, the rest stays."""
+    mirror = np.array([1, 1, -1, 1, -1, 1, -1])
+    for elevation in (0.0, 60.0):
+        left = lawbench.solve("moreau", "billiard", elevation=elevation, offset_side=-0.01)
+        right = lawbench.solve("moreau", "billiard", elevation=elevation, offset_side=0.01)
+        np.testing.assert_allclose(left.v_plus, mirror * right.v_plus, atol=1e-7)
+
+
+def test_english_alone_runs_straight_and_a_masse_shot_curves():
+    """Spin about the vertical leaves the slip at the cloth along the velocity, so the table's
+    friction only slows the ball: the path's curvature is zero for a horizontal shot with side
+    offset; a masse shot's tilted spin axis bends the path, the mirrored shot the other way."""
+    from lawbench.cases.billiard import path_curvature
+
+    from lawbench.checks import Trial
+
+    def curvature(**params):
+        params = CASE.parameters(**params)
+        problem = CASE.build(**params)
+        outcome = lawbench.LAWS.get("moreau").resolve(problem)
+        law = lawbench.LAWS.get("moreau")
+        return path_curvature(Trial(law, CASE, params, {}, problem, outcome, {}))
+
+    assert curvature(offset_side=0.01) == pytest.approx(0.0, abs=1e-9)
+    masse = CASE.examples["masse"]
+    bent = curvature(**masse)
+    assert abs(bent) > 0.1
+    assert curvature(**{**masse, "offset_side": -masse["offset_side"]}) == pytest.approx(-bent)

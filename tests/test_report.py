@@ -422,3 +422,28 @@ def test_the_quick_stability_grid_has_no_nan_and_no_time_out(quick):
     assert not (cells["error_class"].fillna("") == "WorkerDied").any()
     budget = cells[cells["verdict"] == "budget"]
     assert (budget["budget"] != "").all()
+
+
+def test_a_path_study_along_a_parameter_draws_each_cell_side_by_side():
+    """disk_ball_energies: the energetic law's stored energy per contact (J) against time (s)
+    at three impact heights, one panel per height on a shared energy axis; the energy of a
+    contact is never negative and ends at zero (every spring relaxes when the impact ends);
+    struck high, the primary contact passes from the ball D to the floor's far point C."""
+    from lawbench.report.inside import _along
+    from lawbench.runner import Executor, collect
+
+    study = lawbench.study.STUDIES.get("disk_ball_energies")
+    with Executor() as pool:
+        table = collect(study.plan(), pool)
+    drawn = _along(lawbench.CASES.get("disk_ball"), study, table)
+    shown = [ax for ax in drawn.figure.axes if ax.get_visible()]
+    assert [ax.get_title() for ax in shown] == ["b = -0.045 m", "b = 0 m", "b = 0.045 m"]
+    assert {ax.get_ylabel() for ax in shown} == {"stored energy [J]"}
+    assert {ax.get_xlabel() for ax in shown} == {"time [s]"}
+    assert "b = 0.045 m: stored_energy_peaks = [" in drawn.caption
+    assert "primary_contacts = [3, 2]" in drawn.caption
+    data = drawn.data
+    assert set(data["component"]) == {f"contact {j}" for j in range(4)}
+    assert (data["value"] >= 0).all()
+    for _, group in data.groupby(["b", "component"]):
+        assert group["value"].iloc[-1] <= 1e-9 * data["value"].max()

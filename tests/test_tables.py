@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import dataclasses
 import math
 import subprocess
 import sys
@@ -232,6 +233,43 @@ def test_a_sweep_draws_each_measure_against_its_axis_per_law():
     assert set(frame["law"]) == {"moreau"}
     assert sorted(frame["elevation"]) == [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]
     assert {"ball_speed", "spin[0]", "spin[2]", "spin_tilt"} <= set(frame.columns)
-    figure = sweeps._figure("billiard", study.title, frame, "elevation")
-    titles = [ax.get_title() for ax in figure.figure.axes if ax.get_visible()]
-    assert titles == ["ball_speed", "spin[0]", "spin[1]", "spin[2]", "spin_tilt"]
+    units = {**study.units, "elevation": "deg"}
+    figure = sweeps._figure("billiard", study.title, frame, "elevation", units)
+    shown = [ax for ax in figure.figure.axes if ax.get_visible()]
+    velocity = [f"velocity[{k}]" for k in range(3)]
+    spin = [f"spin[{k}]" for k in range(3)]
+    titles = [*velocity, "ball_speed", *spin, "spin_tilt", "curvature"]
+    assert [ax.get_title() for ax in shown] == titles
+    assert {ax.get_xlabel() for ax in shown} == {"elevation [deg]"}
+    ylabels = [ax.get_ylabel() for ax in shown]
+    assert ylabels[:4] == [f"{c} [m/s]" for c in [*velocity, "ball_speed"]]
+    assert ylabels[4:] == [f"{c} [rad/s]" for c in spin] + ["spin_tilt [deg]", "curvature [1/m]"]
+
+
+def test_every_sweep_states_the_unit_of_what_it_draws():
+    """Each panel of a sweep holds one quantity with its unit: the study declares a unit for
+    every measure it draws, and its abscissa is a scene parameter with a unit."""
+    for study in STUDIES:
+        if study.view != "sweep":
+            continue
+        drawn = list(study.axes[1:]) or list(study.measures)
+        assert set(drawn) <= set(study.units), study.name
+        case = lawbench.CASES.get(study.case_names()[0])
+        assert study.axes[0] in {spec.name for spec in case.params}, study.name
+
+
+def test_a_sweep_over_decades_draws_a_log_abscissa():
+    """ping_pong over k2/k1 from 1/10 to 10: a log abscissa, dimensionless rebound ratios."""
+    from lawbench.report import sweeps
+    from lawbench.runner import Executor, collect
+
+    study = STUDIES.get("ping_pong").with_params({}).preset("quick")
+    study = dataclasses.replace(study, laws=("sequential",))
+    with Executor() as pool:
+        table = collect(study.plan(), pool)
+    frame = sweeps._tidy(table, "stiffness_ratio", list(study.measures))
+    units = {**study.units, "stiffness_ratio": ""}
+    figure = sweeps._figure("ping_pong", study.title, frame, "stiffness_ratio", units)
+    shown = [ax for ax in figure.figure.axes if ax.get_visible()]
+    assert {ax.get_xscale() for ax in shown} == {"log"}
+    assert [ax.get_ylabel() for ax in shown] == ["v1_over_v0 [-]", "v2_over_v0 [-]"]

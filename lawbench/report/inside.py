@@ -7,6 +7,11 @@ the way (`lawbench.outcome.Outcome.path`). Each quantity is drawn against the pa
 unit, one line per component, labelled with its name and unit; phases a law reports at normal
 impulses (stick, slip, end of compression) are marked when the impact variable is the normal
 impulse.
+
+A study that names path quantities after its grid parameter in ``axes``
+(`lawbench.study_shapes.impact_paths`) is drawn as one figure: one panel per value of the
+parameter and per quantity named, each quantity's components (one per contact) against the
+impact variable, panels of one quantity on a shared vertical axis.
 """
 
 from __future__ import annotations
@@ -20,11 +25,14 @@ import pandas as pd
 from lawbench.case import Case
 from lawbench.report import plots
 from lawbench.report.page import Figure, Section
-from lawbench.report.runs import Context, parsed
+from lawbench.report.runs import Context, axis_value, parsed
 from lawbench.report.summary import failure
+from lawbench.study import Study
 
 ANCHOR, TITLE, VIEWS = "inside", "Inside an impact", ("inside",)
 MAX_COMPONENTS = 12
+# The lowest value a log axis of `_along` shows, relative to the panel's peak.
+SPREAD = 1e-6
 # What a path's entries are, and their units; 'v' takes the units of the scene's coordinates.
 QUANTITIES = {
     "t": ("time", "s"),
@@ -49,6 +57,9 @@ def build(ctx: Context) -> Section:
         "`path`), each with its unit."
     ]
     for study, table in ctx.tables("inside"):
+        if len(study.axes) > 1:
+            blocks.append(_along(ctx.case(study.case_names()[0]), study, table))
+            continue
         row = table.fillna({"error_class": ""}).to_dict("records")[0]
         found = parsed(row.get("path"))
         if row["error_class"] or not found:
@@ -120,6 +131,87 @@ def _figure(case: Case, what: str, row: dict[str, Any], found: dict[str, Any]) -
         fig,
         pd.concat(data, ignore_index=True) if data else pd.DataFrame(),
     )
+
+
+def _along(case: Case, study: Study, table: pd.DataFrame) -> Figure:
+    """The quantities ``study.axes[1:]`` of each cell's path, one column of panels per cell."""
+    axis, quantities = study.axes[0], list(study.axes[1:])
+    rows = table.fillna({"error_class": ""}).to_dict("records")
+    rows.sort(key=lambda row: axis_value(row, axis))
+    unit = {spec.name: spec.unit for spec in case.params}.get(axis, "")
+    fig, axes = plots.figure(len(quantities), len(rows), width=3.6, height=2.8)
+    data, notes = [], []
+    for col, row in enumerate(rows):
+        value = axis_value(row, axis)
+        heading = f"{axis} = {value:g} {unit}".rstrip()
+        found = None if row["error_class"] else parsed(row.get("path"))
+        if not found:
+            why = failure(row) if row["error_class"] else "the law returned no path"
+            notes.append(f"{heading}: no path, {why}")
+            for ax in axes[:, col]:
+                ax.set_axis_off()
+            continue
+        measured = _measured(row, [name for name in study.measures if name != "path"])
+        if measured:
+            notes.append(f"{heading}: {measured}")
+        path = found["path"]
+        x_key = next(iter(path))
+        x_name, x_unit = QUANTITIES.get(x_key, (x_key, "unit not stated"))
+        x = np.asarray(path[x_key], dtype=float).reshape(-1)
+        for line, key in enumerate(quantities):
+            ax = axes[line, col]
+            if col:
+                ax.sharey(axes[line, 0])
+            name, key_unit = QUANTITIES.get(key, (key, "unit not stated"))
+            values = np.asarray(path.get(key, []), dtype=float).reshape(len(x), -1)
+            for j in range(min(values.shape[1], MAX_COMPONENTS)):
+                part = f"contact {j}" if values.shape[1] > 1 else key
+                ax.plot(x, values[:, j], label=part, linewidth=1.0)
+                data.append(
+                    pd.DataFrame(
+                        {axis: value, x_name: x, "quantity": name, "component": part}
+                        | {"value": values[:, j]}
+                    )
+                )
+            ax.set(title=heading, xlabel=f"{x_name} [{x_unit}]", ylabel=f"{name} [{key_unit}]")
+            ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 3))
+            _spread(ax, values)
+            if 1 < values.shape[1] <= 6:
+                ax.legend(fontsize="xx-small")
+    law = rows[0]["law"]
+    fig.suptitle(f"{law} on {case.name} along {axis}")
+    reproduce = "; ".join(f"`{row['reproducer']}`" for row in rows)
+    caption = f"{study.title}. Reproduce: {reproduce}."
+    if notes:
+        caption += " " + "; ".join(notes) + "."
+    frame = pd.concat(data, ignore_index=True) if data else pd.DataFrame()
+    return Figure(f"inside_{study.name}", caption, fig, frame)
+
+
+def _measured(row: dict[str, Any], names: list[str]) -> str:
+    """``name = value`` of a cell's other measures (numbers to three figures)."""
+    shown = []
+    for name in names:
+        value = parsed(row.get(name))
+        if isinstance(value, list) and all(isinstance(v, int | float) for v in value):
+            shown.append(f"{name} = [{', '.join(f'{v:.3g}' for v in value)}]")
+        elif isinstance(value, int | float) and not isinstance(value, bool):
+            shown.append(f"{name} = {value:.3g}")
+    return ", ".join(shown)
+
+
+def _spread(ax: Any, values: np.ndarray) -> None:
+    """A log axis down to `SPREAD` below the peak for widely spread non-negative components.
+
+    When the components' peaks differ by more than three decades, a contact that stores
+    little is still seen.
+    """
+    peaks = np.nanmax(np.abs(values), axis=0) if values.size else np.zeros(0)
+    if values.size == 0 or (values < 0).any() or peaks.max() <= 0:
+        return
+    if peaks.min() < 1e-3 * peaks.max():
+        ax.set_yscale("log")
+        ax.set_ylim(bottom=SPREAD * peaks.max())
 
 
 def _mark_phases(ax: Any, phases: list[str], impulses: list[float]) -> None:

@@ -4,12 +4,15 @@ A view of the studies declared with ``view="sweep"``: the study's first axis (a 
 is the abscissa, and each of the measures its other axes name (every measure when it names
 none) is drawn against it, one line per law, one panel per
 measure (a vector measure gives one panel per component); the table lists every cell with its
-verdict. Measures name their units in the study's title, so quantities of different units
-never share a panel.
+verdict. An abscissa over two decades or more (a stiffness ratio) is drawn on a log scale.
+The abscissa takes the unit of the scene's parameter, each panel the unit the study
+declares for its measure (``Study.units``): one panel holds one quantity, so quantities of
+different units (m/s, rad/s) never share an axis.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -34,7 +37,8 @@ def build(ctx: Context) -> Section:
         if frame.empty:
             blocks.append(f"Study `{study.name}`: no law answered.")
             continue
-        blocks.append(_figure(study.name, study.title, frame, study.axes[0]))
+        units = _units(ctx, study.case_names()[0], study.axes[0], study.units)
+        blocks.append(_figure(study.name, study.title, frame, study.axes[0], units))
         shown = frame.copy()
         for column in shown.columns.drop(["law", "verdict"]):
             shown[column] = shown[column].map(number)
@@ -60,19 +64,52 @@ def _tidy(table: pd.DataFrame, axis: str, measures: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _units(ctx: Context, case: str, axis: str, declared: Mapping[str, str]) -> dict[str, str]:
+    """Unit per column: the axis's from its scene's parameter, the measures' as declared."""
+    specs = {spec.name: spec for spec in ctx.case(case).params}
+    units = dict(declared)
+    if axis in specs:
+        units[axis] = specs[axis].unit
+    return units
+
+
+def unit_label(name: str, units: Mapping[str, str]) -> str:
+    """``name [unit]`` (``[-]`` dimensionless); a vector's component takes its measure's."""
+    unit = units.get(name, units.get(name.split("[", 1)[0]))
+    if unit is None:
+        return f"{name} [unit not stated]"
+    return f"{name} [{unit or '-'}]"
+
+
+def _decades(values: pd.Series) -> float:
+    """Decades a positive abscissa spans (0 when it reaches zero or below): a log axis from 2."""
+    low, high = float(values.min()), float(values.max())
+    return float(np.log10(high / low)) if low > 0 else 0.0
+
+
 def _number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def _figure(name: str, title: str, frame: pd.DataFrame, axis: str) -> Figure:
+def _figure(
+    name: str,
+    title: str,
+    frame: pd.DataFrame,
+    axis: str,
+    units: Mapping[str, str] | None = None,
+) -> Figure:
     columns = [c for c in frame.columns if c not in ("law", axis, "verdict")]
     rows = -(-len(columns) // PANELS_PER_ROW)
     fig, axes = plots.figure(rows, min(len(columns), PANELS_PER_ROW))
+    units = units or {}
     for ax, column in zip(axes.flat, columns, strict=False):
         for law, group in frame.groupby("law", sort=True):
             ordered = group.sort_values(axis)
             ax.plot(ordered[axis], ordered[column], **plots.law_style(str(law)))
-        ax.set_xlabel(axis)
+        if _decades(frame[axis]) >= 2:
+            ax.set_xscale("log")
+        ax.set_xlabel(unit_label(axis, units))
+        ax.set_ylabel(unit_label(column, units))
         ax.set_title(column)
         ax.legend(fontsize="small")
     for ax in list(axes.flat)[len(columns) :]:
