@@ -29,6 +29,7 @@ import clarabel
 import numpy as np
 import scipy.sparse
 
+from lawbench import budget
 from lawbench.errors import SolverFailure
 from lawbench.solvers import clarabel_settings
 
@@ -106,6 +107,8 @@ def solve_cone_qp(
     solution = solver.solve()
     P, status = np.array(solution.x), str(solution.status)
     exact = polish(G, q, mu, d, P, False) if refine and np.isfinite(P).all() else None
+    if exact is None and status == "MaxTime":
+        budget.current().out_of_time()
     if exact is None and status != "Solved":
         raise SolverFailure(f"clarabel status {status} after {solution.iterations} iterations")
     return ConeResult(P if exact is None else exact, status, solution.iterations, exact is not None)

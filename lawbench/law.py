@@ -3,8 +3,9 @@
 A law subclasses `Law`, declares its name, summary, source, tags, options, findings and
 guarantees, and implements `Law._resolve`. `Law.resolve` does what is common to all of them: it
 checks the options and the problem against the tags, restricts the problem to its closed contacts
-(a contact with a positive gap is not part of this impact), times the solve, and refuses to
-return a non-finite answer.
+(a contact with a positive gap is not part of this impact), times the solve within the budget
+its options set (`lawbench.budget`: every law has ``max_seconds``), and refuses to return a
+non-finite answer.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from lawbench import budget
 from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.mechanics import separating_contacts
@@ -52,6 +54,12 @@ class Law(ABC):
     # How the law treats a closed contact that separates before the impact, stated in the
     # diagnostics of every problem that has one; a law that states no rule refuses them.
     separating_rule: ClassVar[str] = ""
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Give every law the wall-clock budget ``max_seconds`` (`lawbench.budget`)."""
+        super().__init_subclass__(**kwargs)
+        if not any(spec.name == budget.OPTION.name for spec in cls.options):
+            cls.options = (*cls.options, budget.OPTION)
 
     def rule_for_separating(self, options: dict[str, Any]) -> str:
         """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
@@ -118,15 +126,16 @@ class Law(ABC):
             )
         closed = problem.closed
         start = time.perf_counter()
-        if closed.all() or self.follows_gaps:
-            outcome = self._resolve(problem, values)
-        elif closed.any():
-            outcome = _embed(
-                self._resolve(problem.select_contacts(closed), values), closed, problem
-            )
-        else:
-            outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
-            outcome.diagnostics["formulation"] = "no closed contact"
+        with budget.opened(budget.Budget.of(self.name, values)):
+            if closed.all() or self.follows_gaps:
+                outcome = self._resolve(problem, values)
+            elif closed.any():
+                outcome = _embed(
+                    self._resolve(problem.select_contacts(closed), values), closed, problem
+                )
+            else:
+                outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
+                outcome.diagnostics["formulation"] = "no closed contact"
         wall_time = time.perf_counter() - start
         if problem.Wt is not None and outcome.Pt.size == 0:
             outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))

@@ -17,12 +17,13 @@ import numpy as np
 ROUNDING = 4 * float(np.finfo(float).eps)
 
 
-def crossing(function: Callable[[float], float], lo: float, hi: float) -> float:
+def crossing(function: Callable[[float], float], lo: float, hi: float, past: bool = True) -> float:
     """A point just past the sign change of ``function`` in ``(lo, hi]``.
 
     The old sign is the one at ``lo``, the new one the one at ``hi``; when they agree there is
     no change and ``hi`` is returned. A function that Brent's method cannot pin down (a jump
-    rather than a zero) is bisected.
+    rather than a zero) is bisected. With ``past`` False, Brent's root itself is returned (to
+    rounding, on either side of the zero).
     """
     import scipy.optimize  # on first use: registering a law imports no optimizer
 
@@ -33,6 +34,8 @@ def crossing(function: Callable[[float], float], lo: float, hi: float) -> float:
         root = scipy.optimize.brentq(function, lo, hi, xtol=1e-300, rtol=ROUNDING, maxiter=200)
     except RuntimeError:
         return _bisect(function, lo, hi, old)
+    if not past:
+        return root
     step = np.spacing(max(abs(root), abs(hi - lo)))
     while root < hi and np.sign(function(root)) != new:
         root = min(root + step, hi)

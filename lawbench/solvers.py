@@ -29,6 +29,7 @@ import scipy.optimize
 import scipy.sparse
 import scipy.sparse.linalg
 
+from lawbench import budget
 from lawbench.errors import SolverFailure
 from lawbench.mechanics import is_diagonal
 from lawbench.problem import SPARSE_SHARE
@@ -57,6 +58,7 @@ def clarabel_settings(tol: float, max_iter: int) -> clarabel.DefaultSettings:
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = max_iter
+    settings.time_limit = budget.current().seconds_left
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
     settings.tol_ktratio = max(tol, 1e-12)
     return settings
@@ -342,6 +344,8 @@ def _finish(
     exact = polish(G, q, z) if refine and np.isfinite(z).all() else None
     if exact is not None:
         z = exact
+    elif result.status == "MaxTime":
+        budget.current().out_of_time()
     elif result.status != "Solved":
         raise SolverFailure(f"clarabel status {result.status} after {result.iterations} iterations")
     return LCPResult(

@@ -42,19 +42,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from functools import partial
 from typing import Any
 
 import numpy as np
 import scipy.optimize
 
-from lawbench import budget
 from lawbench.claims import keeps_energy, never_creates_energy
-from lawbench.errors import BudgetExceeded, NotApplicable, SolverFailure
+from lawbench.errors import NotApplicable
+from lawbench.integrator import EventIntegrator
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
-from lawbench.roots import crossing
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 
@@ -151,7 +149,6 @@ class Compliant(Law):
         Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
         Spec("max_events", 100_000, "budget of restarts at contact events", "", "int", 1),
         Spec("path", False, "return time histories of forces and stored energies", "", "bool"),
-        budget.OPTION,
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
@@ -251,66 +248,39 @@ class _Integration:
 
     def run(self) -> Outcome:
         problem, options = self.problem, self.options
-        y = np.concatenate([problem.gaps / self.L, problem.v / self.V, np.zeros(problem.m)])
-        import scipy.integrate  # on first use: registering the law imports no integrator
-
-        method = getattr(scipy.integrate, options["method"])
-        rtol = options["tol"]
-        t, steps, restarts = 0.0, 0, 0
-        peak = np.zeros(problem.m)
-        history: list[tuple[float, np.ndarray]] = [(0.0, y)]
-        solver = method(self.rhs, t, y, np.inf, rtol=rtol, atol=rtol * 1e-3)
-        deadline = budget.Deadline("compliant", options["max_seconds"])
-        while not self.ended(y):
-            deadline.check()
-            if steps == options["max_steps"]:
-                raise BudgetExceeded(
-                    f"compliant: integrator step budget ran out ({steps} steps, max_steps)",
-                    "max_steps",
-                    steps,
-                )
-            before = self.switches(*self.physical(y)[::2])
-            message = solver.step()
-            steps += 1
-            if solver.status == "failed":
-                raise SolverFailure(f"compliant: {options['method']} failed: {message}")
-            dense = solver.dense_output()
-            t_new, y_new = solver.t, solver.y
-            after = self.switches(*self.physical(y_new)[::2])
-            crossed = np.flatnonzero(np.sign(before) != np.sign(after))
-            if crossed.size:
-                t_new = min(crossing(partial(self._switch, dense, j), t, t_new) for j in crossed)
-                y_new = dense(t_new)
-                restarts += 1
-                if restarts > options["max_events"]:
-                    raise BudgetExceeded(
-                        f"compliant: event budget ran out ({restarts - 1} restarts, max_events)",
-                        "max_events",
-                        options["max_events"],
-                    )
-            for s in np.linspace(t, t_new, 5)[1:]:
-                peak = np.maximum(peak, self.forces(*self.physical(dense(s))[::2]))
-            t, y = t_new, y_new
-            if options["path"]:
-                history.append((t, y))
-            if crossed.size:
-                solver = method(self.rhs, t, y, np.inf, rtol=rtol, atol=rtol * 1e-3)
         m, n = problem.m, problem.n
+        y = np.concatenate([problem.gaps / self.L, problem.v / self.V, np.zeros(m)])
+        rtol = options["tol"]
+        integrator = EventIntegrator(options["method"], rtol, rtol * 1e-3)
+        t, self.steps, events = 0.0, 0, 0
+        self.peak = np.zeros(m)
+        self.history: list[tuple[float, np.ndarray]] = [(0.0, y)]
+        while not self.ended(y):
+            event = integrator.to_event(self.rhs, t, y, self._switches, on_step=self._on_step)
+            t, y, events = event.x, event.y, events + 1
         diagnostics = {
             "formulation": f"time integration ({self.model}, {options['method']})",
             "duration_s": t * self.tau,
-            "peak_force": peak.tolist(),
+            "peak_force": self.peak.tolist(),
             "damping": self.c.tolist(),
-            "steps": steps,
-            "events": restarts,
+            "steps": self.steps,
+            "events": events,
         }
-        path = self._path(history) if options["path"] else None
+        path = self._path(self.history) if options["path"] else None
         return Outcome.from_velocity(
             problem, self.V * y[m : m + n], self.I * y[m + n :], diagnostics=diagnostics, path=path
         )
 
-    def _switch(self, dense: Callable[[float], np.ndarray], j: int, s: float) -> float:
-        return float(self.switches(*self.physical(dense(s))[::2])[j])
+    def _switches(self, t: float, y: np.ndarray) -> np.ndarray:
+        return self.switches(*self.physical(y)[::2])
+
+    def _on_step(self, dense: Callable[[float], np.ndarray], t_old: float, t: float) -> None:
+        """Count the step, keep the peak forces (four points) and the path's point."""
+        self.steps += 1
+        for s in np.linspace(t_old, t, 5)[1:]:
+            self.peak = np.maximum(self.peak, self.forces(*self.physical(dense(s))[::2]))
+        if self.options["path"]:
+            self.history.append((t, dense(t)))
 
     def _path(self, history: list[tuple[float, np.ndarray]]) -> dict[str, np.ndarray]:
         times = np.array([t for t, _ in history]) * self.tau

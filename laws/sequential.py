@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from lawbench import budget
 from lawbench.claims import RIGID_DISPERSION, keeps_energy, never_creates_energy
-from lawbench.errors import BudgetExceeded
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
@@ -75,7 +75,7 @@ class Sequential(Law):
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
-        impacts = _BinaryImpacts(problem, options["max_steps"])
+        impacts = _BinaryImpacts(problem)
         if options["order"] == "fastest_first":
             while impacts.un.min() < impacts.threshold:
                 impacts.strike(int(np.argmin(impacts.un)))
@@ -104,9 +104,9 @@ class Sequential(Law):
 class _BinaryImpacts:
     """The state of a sequence of binary impacts: gap rates, impulses, the impacts so far."""
 
-    def __init__(self, problem: ImpactProblem, max_impacts: int) -> None:
+    def __init__(self, problem: ImpactProblem) -> None:
         self.problem = problem
-        self.max_impacts = max_impacts
+        self.spend = budget.current()
         self.G = problem.delassus
         self.e = problem.restitution("newton")
         self.un = problem.un.copy()
@@ -116,15 +116,11 @@ class _BinaryImpacts:
         self.impulses: list[float] = []
 
     def strike(self, j: int) -> None:
-        """Newton's binary impact at contact j alone; raise past the bound on impacts."""
-        if len(self.contacts) == self.max_impacts:
-            raise BudgetExceeded(
-                f"sequential: contacts still approach after {len(self.contacts)} binary impacts "
-                f"(max_steps = {self.max_impacts}; a sequence that does not end, such as an "
-                "inelastic collapse)",
-                "max_steps",
-                self.max_impacts,
-            )
+        """Newton's binary impact at contact j alone, a step of the solve's budget."""
+        self.spend.step(
+            "binary impacts",
+            "contacts still approach: a sequence that does not end, such as an inelastic collapse",
+        )
         impulse = -(1.0 + self.e[j]) * self.un[j] / self.G[j, j]
         self.Pn[j] += impulse
         self.un += self.G[:, j] * impulse

@@ -114,7 +114,7 @@ def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
     assert computed == 2
     assert list(table["error_class"].fillna("")) == ["BudgetExceeded", ""]
     assert list(table["verdict"]) == ["budget", "holds"]
-    assert "after 5 binary impacts" in table["error_message"][0]
+    assert "step budget ran out (5 binary impacts" in table["error_message"][0]
 
 
 def test_resume_computes_only_what_is_missing(tmp_path):

@@ -127,6 +127,7 @@ class DarbouxKeller(Law):
             "",
             "bool",
         ),
+        Spec("max_steps", 100_000, "budget of integrator steps of turning slip", "", "int", 1),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -14,9 +14,10 @@ in ``Pn``, so every event (slip stop, end of compression, termination) is a clos
 Stick and slip from rest keep their ``r`` for the rest of the impact; planar slip with
 ``ut != 0`` is affine too, and so is spatial slip whose rate ``Gtn - mu Gtt ut/|ut|`` lies along
 ``ut`` (a sphere, or slip in a plane of symmetry). Other spatial slip turns its direction
-(Brogliato 2010, eq. 15): it is integrated with scipy's ``solve_ivp`` until it stops, the impact
-ends, or the slip speed falls below a threshold proportional to ``rtol``, where sticking or slip
-in a fixed direction (Darboux's proposition) takes over exactly. Its clock is ``tau`` with
+(Brogliato 2010, eq. 15): it is integrated with the shared event integrator
+(`lawbench.integrator`) until it stops, the impact ends, or the slip speed falls below a
+threshold proportional to ``rtol``, where sticking or slip in a fixed direction (Darboux's
+proposition) takes over exactly. Its clock is ``tau`` with
 ``dPn = |ut| dtau``, which makes the right-hand side smooth; near the stop the slip direction
 relaxes much faster than the slip decays (stiff), hence the implicit Radau method with the
 exact Jacobian.
@@ -30,11 +31,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import partial
 
 import numpy as np
 import scipy.optimize
 
 from lawbench.errors import NotApplicable, SolverFailure
+from lawbench.integrator import EventIntegrator
 
 # Velocity-like quantities below this fraction of |u-| are zero; impulses likewise.
 ROUNDING = 1e-12
@@ -44,6 +47,8 @@ SAMPLES = 17
 MAX_PHASES = 12
 # An impact whose impulse exceeds this many frictionless compression impulses does not end.
 IMPULSE_BOUND = 1e8
+# The order of the events of turning slip (`SingleContactImpact._events`).
+SLIP_STOPS, BOUND = 0, 1
 
 
 @dataclass(frozen=True)
@@ -260,8 +265,6 @@ class SingleContactImpact:
         smooth, and ``ut = 0`` is a rest point the integrator cannot step across (in ``Pn`` the
         direction ``ut/|ut|`` jumps there and explicit steps chatter about zero).
         """
-        from scipy.integrate import solve_ivp  # on first use: registering imports none
-
         self.record.enter("slip", 0.0)
         for _ in range(MAX_PHASES):
             if self.record.compression is not None and self._reached(state):
@@ -276,33 +279,30 @@ class SingleContactImpact:
             else:
                 work = -c.W
             scale = np.array([self.impulse_scale] * 3 + [work])
-            events = self._events(state.W)
-            solution = solve_ivp(
+            integrator = EventIntegrator("Radau", self.rtol, self.rtol * scale)
+            points = [np.concatenate([[state.P], state.Pt, [0.0]])]
+            event = integrator.to_event(
                 self._slip_rate,
-                (0.0, IMPULSE_BOUND * self.impulse_scale / self.slip_floor),
-                np.concatenate([[state.P], state.Pt, [0.0]]),
-                method="Radau",
+                0.0,
+                points[0],
+                partial(_values, self._events(state.W)),
+                np.array([-1.0, 1.0, 1.0]),
+                x_end=IMPULSE_BOUND * self.impulse_scale / self.slip_floor,
                 jac=self._slip_jacobian,
-                rtol=self.rtol,
-                atol=self.rtol * scale,
-                events=events,
+                on_step=partial(_keep_end, points),
             )
-            if solution.status < 0:
-                raise SolverFailure(f"darboux_keller: solve_ivp failed ({solution.message})")
-            self.record.steps += solution.t.size - 1
-            P, Pt, W = solution.y[0], solution.y[1:3].T, state.W + solution.y[3]
+            self.record.steps += len(points) - 1
+            y = np.array(points)
+            P, Pt, W = y[:, 0], y[:, 1:3], state.W + y[:, 3]
             u = self.u_minus + np.outer(P, self.G[:, 0]) + Pt @ self.G[:, 1:].T
             self.record.sample(P, Pt, u, W)
             state = State(float(P[-1]), Pt[-1], u[-1], float(W[-1]))
-            fired = [
-                event for event, times in zip(events, solution.t_events, strict=True) if times.size
-            ]
-            if not fired or fired[0].__name__ == "bound":
+            if event is None or event.fired[0] == BOUND:
                 raise SolverFailure(
                     f"darboux_keller: slip goes on past {IMPULSE_BOUND:g} times the "
                     "frictionless compression impulse"
                 )
-            if fired[0].__name__ == "slip_stops":
+            if event.fired[0] == SLIP_STOPS:
                 return state
             if self.record.compression is not None:
                 return self._finish(state, "end of impact")
@@ -326,7 +326,7 @@ class SingleContactImpact:
         return jacobian
 
     def _events(self, work: float) -> list[Callable[[float, np.ndarray], float]]:
-        """Slip stop, impulse bound, then end of compression or the termination (terminal).
+        """Slip stop (falling), impulse bound, then end of compression or the termination.
 
         ``work`` is the normal work at the start of the stretch, where ``y[3]`` starts from 0.
         """
@@ -355,11 +355,7 @@ class SingleContactImpact:
             if c is None
             else {"newton": newton, "poisson": poisson}.get(self.termination, energetic)
         )
-        events = [slip_stops, bound, last]
-        for event in events:
-            event.terminal = True
-            event.direction = -1 if event is slip_stops else 1
-        return events
+        return [slip_stops, bound, last]
 
     def _reached(self, state: State) -> bool:
         """Whether the termination holds at ``state`` (compression over)."""
@@ -387,3 +383,15 @@ def path_arrays(record: ImpactRecord) -> dict[str, np.ndarray]:
     """The samples of ``record`` joined: Pn, Pt (k, d), un, ut (k, d), Wn."""
     P, Pt, u, W = (np.concatenate(parts) for parts in zip(*record.samples, strict=True))
     return {"Pn": P, "Pt": Pt, "un": u[:, 0], "ut": u[:, 1:], "Wn": W}
+
+
+def _values(
+    functions: list[Callable[[float, np.ndarray], float]], tau: float, y: np.ndarray
+) -> np.ndarray:
+    """The event functions at ``(tau, y)``."""
+    return np.array([function(tau, y) for function in functions])
+
+
+def _keep_end(points: list[np.ndarray], dense: Callable, tau_old: float, tau: float) -> None:
+    """Keep the state at the end of each step."""
+    points.append(dense(tau))

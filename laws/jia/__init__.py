@@ -148,6 +148,8 @@ class Jia(Law):
             "",
             "bool",
         ),
+        Spec("max_steps", 1_000_000, "budget of integrator steps", "", "int", 1),
+        Spec("max_events", 10_000, "budget of contact state transitions", "", "int", 1),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
@@ -219,7 +221,7 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
 def _path(impact: SpringImpact, eta0_sq: float) -> dict[str, np.ndarray]:
     """The impulse curve from the samples of ``impact``: impulses, energies, velocities."""
     m, d = impact.m, impact.d
-    samples = np.vstack(impact.record.samples)
+    samples = np.array(impact.record.samples)
     states = samples[:, 1:]
     velocities = np.array([impact.velocity(s) for s in states])
     return {

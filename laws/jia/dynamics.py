@@ -50,8 +50,9 @@ are regular (multiplied by ``dI_n/dtau``)::
 
 with ``rho = -mu kappa eta0^2 un`` (the rate of ``|g|`` that keeps ``|F_t| = mu F_n``),
 ``E_t = |g|^2 / (4 eta0^2)`` and the stick bound ``|g| <= 2 mu eta0^2 sqrt(kappa) y``. Every
-transition is an event of scipy's ``solve_ivp`` (DOP853); the contact velocity is affine in the
-impulses, ``u = u- + G [I_n, I_t]`` with ``G`` the contact Delassus matrix.
+transition is an event of the shared event integrator (`lawbench.integrator`, DOP853); the
+contact velocity is affine in the impulses, ``u = u- + G [I_n, I_t]`` with ``G`` the contact
+Delassus matrix.
 """
 
 from __future__ import annotations
@@ -64,18 +65,15 @@ from functools import partial
 import numpy as np
 
 from lawbench.errors import SolverFailure
+from lawbench.integrator import EventIntegrator
 
 # Gap rates above -max(ROUNDING, 100 tolerance) |u-| count as not approaching: a grazing
 # contact is not reactivated by the integration's noise.
 ROUNDING = 1e-12
-# Events closer than this fraction of the time scale happen together.
-SIMULTANEOUS = 1e-9
-MAX_SEGMENTS = 10_000
 # A contact this much stiffer than the softest other loaded spring is rigid (see above).
 LOCK = 1e6
 # A segment with no event within this many natural periods does not end.
 PERIODS = 1e4
-SAMPLES = 33
 
 
 @dataclass(frozen=True)
@@ -247,9 +245,12 @@ class SpringImpact:
     def _spring(self, s: np.ndarray, j: int) -> float:
         return float(s[self.m + j])
 
-    def _events(self) -> list:
-        """The armed events; each starts on its quiet side, so none fires at its own start."""
-        armed: list[tuple[str, int, Callable, int]] = []
+    def _events(self) -> list[tuple[str, int, Callable[[np.ndarray], float], int]]:
+        """The armed events ``(name, contact, function, direction)``.
+
+        Each starts on its quiet side, so none fires at its own start.
+        """
+        armed: list[tuple[str, int, Callable[[np.ndarray], float], int]] = []
         rows = np.cumsum(self.locked) - 1
         for j in range(self.m):
             if self.locked[j]:
@@ -266,52 +267,57 @@ class SpringImpact:
                 armed.append(("slip", 0, self._stick_margin, 1))
             else:
                 armed.append(("stick", 0, self._slip_speed, -1))
-        return [_event(*entry) for entry in armed]
+        return armed
 
     # --- the run --------------------------------------------------------------------------------
 
     def run(self) -> np.ndarray:
-        """Integrate the impact; return the final state ``[I_n, y, I_t, g]``."""
-        from scipy.integrate import solve_ivp  # on first use: registering imports none
+        """Integrate the impact; return the final state ``[I_n, y, I_t, g]``.
 
+        Each transition is an event of the solve's budget (``max_events``), each integrator
+        step a step (``max_steps``).
+        """
+        integrator = EventIntegrator(
+            "DOP853",
+            self.tolerance,
+            self.tolerance * self.scale,
+            past=False,
+        )
         tau, s = 0.0, np.zeros(2 * (self.m + self.d))
         self._note_state(tau, s, ["stick" if self.stick else "slip"] if self.d else [])
-        for _ in range(MAX_SEGMENTS):
+        while True:
             s = self._settle(s)
             if not self.active.any():
                 return s
-            events = self._events()
-            solution = solve_ivp(
-                self._rate,
-                (tau, tau + PERIODS * self.time_scale),
-                s,
-                method="DOP853",
-                rtol=self.tolerance,
-                atol=self.tolerance * self.scale,
-                events=events,
-                dense_output=self.keep_path,
-            )
-            if solution.status < 0:
-                raise SolverFailure(f"jia: solve_ivp failed ({solution.message})")
-            self.record.steps += len(solution.t) - 1
+            armed = self._events()
             if self.keep_path:
-                grid = np.linspace(tau, solution.t[-1], SAMPLES)
-                self.record.samples.append(np.vstack([grid, solution.sol(grid)]).T)
-            if solution.status == 0:
+                self.record.samples.append(np.append(tau, s))
+            event = integrator.to_event(
+                self._rate,
+                tau,
+                s,
+                partial(_values, [function for _, _, function, _ in armed]),
+                np.array([direction for *_, direction in armed], dtype=float),
+                x_end=tau + PERIODS * self.time_scale,
+                on_step=self._on_step,
+            )
+            if event is None:
                 raise SolverFailure(
                     f"jia: no contact event within {PERIODS:g} natural periods: the impact "
                     "does not end"
                 )
-            tau, s = float(solution.t[-1]), solution.y[:, -1].copy()
-            fired = [
-                event.label
-                for event, times in zip(events, solution.t_events, strict=True)
-                if times.size and abs(times[-1] - tau) <= SIMULTANEOUS * self.time_scale
-            ]
-            for name, j in fired:
-                s = self._apply(name, j, s)
-            self._note_state(tau, s, [name for name, _ in fired])
-        raise SolverFailure(f"jia: the impact did not end within {MAX_SEGMENTS} transitions")
+            tau, s = event.x, event.y.copy()
+            # One transition at a time: the first. A spring that empties with it, a contact
+            # that then approaches or a lock that then pulls is settled at the restart; an
+            # event function another transition leaves past its zero is armed again from there.
+            name, j = armed[event.fired[0]][:2]
+            s = self._apply(name, j, s)
+            self._note_state(tau, s, [name])
+
+    def _on_step(self, dense: Callable[[float], np.ndarray], tau_old: float, tau: float) -> None:
+        self.record.steps += 1
+        if self.keep_path:
+            self.record.samples.append(np.append(tau, dense(tau)))
 
     def _settle(self, s: np.ndarray) -> np.ndarray:
         """Separate emptied springs, reactivate approaching contacts, release pulling locks.
@@ -417,11 +423,8 @@ class SpringImpact:
 _PHASE_NAMES = {"separation": "end of impact"}
 
 
-def _event(name: str, j: int, function: Callable, direction: int) -> Callable:
-    """A terminal ``solve_ivp`` event named ``(name, j)`` on ``function(state)``."""
-
-    def event(tau: float, s: np.ndarray) -> float:
-        return function(s)
-
-    event.terminal, event.direction, event.label = True, direction, (name, j)
-    return event
+def _values(
+    functions: list[Callable[[np.ndarray], float]], tau: float, s: np.ndarray
+) -> np.ndarray:
+    """The event functions at state ``s``."""
+    return np.array([function(s) for function in functions])

@@ -116,7 +116,6 @@ import numpy as np
 import scipy.special
 from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
-from lawbench import budget
 from lawbench.claims import (
     ENERGETIC_DISSIPATION,
     FROZEN_CONFIGURATION,
@@ -173,7 +172,6 @@ class LiuZhaoBrogliato(Law):
         ),
         Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
         Spec("max_events", 20_000, "budget of restarts at events", "", "int", 1),
-        budget.OPTION,
         Spec(
             "path",
             False,
@@ -197,9 +195,6 @@ class LiuZhaoBrogliato(Law):
             options["variant"],
             options["tol"],
             options["method"],
-            options["max_steps"],
-            options["max_events"],
-            options["max_seconds"],
             options["path"],
         )
         y = impact.run()

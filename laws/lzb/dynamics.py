@@ -31,10 +31,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lawbench import budget
-from lawbench.errors import BudgetExceeded, SolverFailure
+from lawbench.errors import SolverFailure
+from lawbench.integrator import EventIntegrator
 from lawbench.problem import ImpactProblem
-from lawbench.roots import crossing
 
 IDLE, COMPRESSION, EXPANSION = 0, 1, 2
 # The primary impulse is the independent variable while the primary contact stores at least
@@ -112,10 +111,6 @@ class EnergeticImpact:
         Relative tolerance of the integrator (absolute: ``1e-3 rtol`` in scaled units).
     method : str
         scipy ``OdeSolver`` class name.
-    max_steps, max_events : int
-        Budgets of integrator steps and of restarts at events.
-    max_seconds : float
-        Wall-clock budget.
     record_path : bool
         Keep the states along the impact.
     """
@@ -126,17 +121,11 @@ class EnergeticImpact:
         variant: str,
         rtol: float,
         method: str,
-        max_steps: int,
-        max_events: int,
-        max_seconds: float,
         record_path: bool,
     ) -> None:
-        self.deadline = budget.Deadline("lzb", max_seconds)
         self.problem, self.variant, self.rtol = problem, variant, rtol
-        import scipy.integrate  # on first use: registering the law imports no integrator
-
-        self.method = getattr(scipy.integrate, method)
-        self.max_steps, self.max_events, self.record_path = max_steps, max_events, record_path
+        self.integrator = EventIntegrator(method, rtol, rtol * 1e-3, samples=SAMPLES)
+        self.record_path = record_path
         m = self.m = problem.m
         self.friction = problem.frictional
         C = problem.contact_delassus if self.friction else problem.delassus
@@ -416,57 +405,21 @@ class EnergeticImpact:
     def segment(self, y: np.ndarray, seg: Segment) -> tuple[np.ndarray, Segment | None]:
         """Integrate from ``y`` to the first event; return the state after it and what follows."""
         x = y[-1] if seg.primary < 0 else y[seg.primary]
-        atol = self.rtol * 1e-3
-        solver = self.method(self.field(seg), x, y, np.inf, rtol=self.rtol, atol=atol)
         kind = "time" if seg.primary < 0 else "impulse"
-        before = self.switching(y, seg)
-        while True:
-            self.deadline.check()
-            if sum(self.steps.values()) >= self.max_steps:
-                raise BudgetExceeded(
-                    f"lzb: integrator step budget ran out ({self.max_steps} steps, max_steps)",
-                    "max_steps",
-                    self.max_steps,
-                )
-            message = solver.step()
+
+        def on_step(dense: Callable[[float], np.ndarray], x_old: float, x_new: float) -> None:
             self.steps[kind] += 1
-            if solver.status == "failed":
-                raise SolverFailure(f"lzb: the integrator failed: {message}")
-            dense = solver.dense_output()
-            armed = before >= 0
-            start = solver.t_old
-            for x_k in np.linspace(solver.t_old, solver.t, SAMPLES + 1)[1:]:
-                y_k = solver.y if x_k == solver.t else dense(x_k)
-                values = self.switching(y_k, seg)
-                crossed = np.flatnonzero(armed & (values < 0))
-                if crossed.size:
-                    x_hit = min(
-                        _crossing(lambda x, i=i, d=dense: self.switching(d(x), seg)[i], start, x_k)
-                        for i in crossed
-                    )
-                    self.events += 1
-                    if self.events > self.max_events:
-                        raise BudgetExceeded(
-                            f"lzb: event budget ran out ({self.max_events} events, max_events)",
-                            "max_events",
-                            self.max_events,
-                        )
-                    y_hit = dense(x_hit)
-                    self.keep(y_hit, seg)
-                    y_new, seg_new = self.classify(y_hit, seg)
-                    self.keep(y_new, seg_new)
-                    return y_new, seg_new
-                self.keep(y_k, seg)
-                start = x_k
-            before = values
+            if self.record_path:
+                for x_k in np.linspace(x_old, x_new, SAMPLES + 1)[1:]:
+                    self.keep(dense(x_k), seg)
 
-
-def _crossing(function: Callable[[float], float], lo: float, hi: float) -> float:
-    """A point just past the first zero of ``function`` in ``(lo, hi]`` (negative at ``hi``).
-
-    ``lo`` itself when the function is already negative there.
-    """
-    return lo if function(lo) < 0 else crossing(function, lo, hi)
+        event = self.integrator.to_event(
+            self.field(seg), x, y, lambda x, y: self.switching(y, seg), -1.0, on_step=on_step
+        )
+        self.events += 1
+        y_new, seg_new = self.classify(event.y, seg)
+        self.keep(y_new, seg_new)
+        return y_new, seg_new
 
 
 def _box_qp(A: np.ndarray, b: np.ndarray, bound: np.ndarray) -> np.ndarray:

@@ -1,0 +1,154 @@
+"""The shared event integrator and the one budget mechanism every law spends from."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+import lawbench
+from lawbench import budget
+from lawbench.errors import BudgetExceeded
+from lawbench.integrator import EventIntegrator
+
+
+def harmonic(t: float, y: np.ndarray) -> np.ndarray:
+    """y'' = -y: from (0, 1) the solution is (sin t, cos t)."""
+    return np.array([y[1], -y[0]])
+
+
+def test_an_event_is_located_to_rounding_just_past_its_zero():
+    """sin t falls through zero at pi: the state returned lies just past it, on the new sign."""
+    event = EventIntegrator(rtol=1e-12, atol=1e-14).to_event(
+        harmonic, 0.0, np.array([0.0, 1.0]), lambda t, y: y[:1], direction=-1.0
+    )
+    assert event.fired == (0,)
+    assert event.x == pytest.approx(math.pi, rel=1e-12)
+    assert event.y[0] < 0 and abs(event.y[0]) < 1e-11
+
+
+def test_direction_selects_the_change_of_sign():
+    """cos t falls through zero at pi/2 and rises at 3 pi/2; +1 waits for the rise."""
+    start = np.array([0.0, 1.0])
+    integrator = EventIntegrator(rtol=1e-12, atol=1e-14)
+    falling = integrator.to_event(harmonic, 0.0, start, lambda t, y: y[1:], direction=-1.0)
+    rising = integrator.to_event(harmonic, 0.0, start, lambda t, y: y[1:], direction=1.0)
+    either = integrator.to_event(harmonic, 0.0, start, lambda t, y: y[1:])
+    assert falling.x == pytest.approx(math.pi / 2, rel=1e-12)
+    assert rising.x == pytest.approx(3 * math.pi / 2, rel=1e-12)
+    assert either.x == falling.x
+
+
+def test_the_first_of_several_events_and_those_simultaneous_with_it():
+    """Two functions cross at atan(1 / 0.999) and pi/4: pi/4 first, both within 1e-3."""
+    start = np.array([0.0, 1.0])
+
+    def events(t: float, y: np.ndarray) -> np.ndarray:
+        return np.array([y[1] - 0.999 * y[0], y[1] - y[0]])
+
+    first = EventIntegrator(rtol=1e-12, atol=1e-14).to_event(harmonic, 0.0, start, events, -1.0)
+    assert first.fired == (1,) and first.x == pytest.approx(math.pi / 4, rel=1e-12)
+    both = EventIntegrator(rtol=1e-12, atol=1e-14, simultaneous=1e-3).to_event(
+        harmonic, 0.0, start, events, -1.0
+    )
+    assert both.fired == (1, 0)
+
+
+def test_no_event_before_the_end_returns_none_and_every_step_is_seen():
+    """No event before x_end; the steps seen are contiguous from the start to the end."""
+    seen = []
+    event = EventIntegrator().to_event(
+        harmonic,
+        0.0,
+        np.array([0.0, 1.0]),
+        lambda t, y: np.array([y[0] + 2.0]),
+        x_end=10.0,
+        on_step=lambda dense, t_old, t: seen.append((t_old, t)),
+    )
+    assert event is None
+    assert seen[0][0] == 0.0 and seen[-1][1] == 10.0
+    assert all(a[1] == b[0] for a, b in itertools.pairwise(seen))
+
+
+@pytest.mark.parametrize(
+    ("limits", "option"),
+    [({"max_steps": 3}, "max_steps"), ({"max_events": 2}, "max_events")],
+)
+def test_the_open_budget_bounds_steps_and_events(limits, option):
+    """Steps and events are spent from the budget the solve opened; it names what ran out."""
+    integrator = EventIntegrator(rtol=1e-12, atol=1e-14)
+    with budget.opened(budget.Budget("a law", **limits)):
+        with pytest.raises(BudgetExceeded, match=f"a law: .* budget ran out .*{option}") as info:
+            y = np.array([0.0, 1.0])
+            for _ in range(10):  # each event is a zero of sin t
+                event = integrator.to_event(harmonic, 0.0, y, lambda t, y: y[:1])
+                y = event.y
+    assert info.value.budget == option and info.value.spent_s >= 0
+
+
+def test_the_time_budget_stops_a_long_integration():
+    """An integration that would take long stops at max_seconds, naming it."""
+    with budget.opened(budget.Budget("a law", max_seconds=1e-3)):
+        with pytest.raises(BudgetExceeded, match=r"time budget ran out \(0.001 s") as info:
+            EventIntegrator(rtol=1e-13, atol=1e-15).to_event(
+                harmonic, 0.0, np.array([0.0, 1.0]), lambda t, y: np.array([1.0]), x_end=1e9
+            )
+    assert info.value.budget == "max_seconds" and info.value.spent_s >= 1e-3
+
+
+def test_every_law_has_a_time_budget():
+    """Every registered law declares ``max_seconds`` (given by the law protocol)."""
+    for law in lawbench.LAWS:
+        assert "max_seconds" in [spec.name for spec in law.options], law.name
+
+
+# A scene on which each law with a step budget steps: integrator steps, fixed-point steps of
+# Coulomb's law, binary impacts.
+STEPPING = {
+    "compliant": ("three_ball_chain", {}, {}),
+    "lzb": ("three_ball_chain", {}, {}),
+    "jia": ("two_balls_wall", {}, {}),
+    "darboux_keller": None,
+    "moreau": ("lamina", {}, {"friction": "coulomb"}),
+    "sequential": ("two_balls_wall", {"e": 0.0}, {}),
+}
+
+
+@pytest.mark.parametrize("name", sorted(STEPPING))
+def test_every_step_budget_is_spent_through_the_solve_budget(name):
+    """``max_steps = 1`` stops each law that steps, with `BudgetExceeded` naming max_steps."""
+    law = lawbench.LAWS.get(name)
+    assert "max_steps" in [spec.name for spec in law.options]
+    if STEPPING[name] is None:
+        problem = turning_slip_problem()
+        options = {}
+    else:
+        case, params, options = STEPPING[name]
+        problem = lawbench.CASES.get(case).build(**params)
+    with pytest.raises(BudgetExceeded, match=r"step budget ran out \(1 ") as info:
+        law.resolve(problem, max_steps=1, **options)
+    assert info.value.budget == "max_steps" and info.value.amount == 1
+
+
+def test_the_laws_with_a_step_budget_are_all_tested():
+    """A law that declares max_steps joins the table above."""
+    declared = {
+        law.name for law in lawbench.LAWS if any(s.name == "max_steps" for s in law.options)
+    }
+    assert declared == set(STEPPING)
+
+
+def turning_slip_problem() -> lawbench.ImpactProblem:
+    """One spatial frictional contact whose slip direction turns (Darboux-Keller's ODE)."""
+    rng = np.random.default_rng(1)
+    A = rng.normal(size=(4, 4))
+    Wn, v = rng.normal(size=(4, 1)), rng.normal(size=4)
+    return lawbench.ImpactProblem(
+        M=A @ A.T + 1.2 * np.eye(4),
+        Wn=Wn,
+        Wt=rng.normal(size=(4, 2)),
+        v=-v if Wn[:, 0] @ v > 0 else v,
+        contacts=[lawbench.Contact(e=0.5, mu=0.8)],
+    )
