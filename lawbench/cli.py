@@ -229,6 +229,7 @@ def _report(args: argparse.Namespace) -> None:
 
 
 def _study(args: argparse.Namespace) -> None:
+    from lawbench.runfile import file_format, metadata, save_run
     from lawbench.tables import study_table
 
     if args.list:
@@ -238,10 +239,13 @@ def _study(args: argparse.Namespace) -> None:
     if not args.name:
         raise InvalidProblem("study: give a study's name, or --list")
     given = _assignments(args.set, "--set")
+    if args.out:
+        file_format(Path(args.out))  # a bad extension stops before any cell is computed
     table = study_table(args.name, given, args.executor, args.workers, args.max_seconds)
     print(table.text())
     if args.out:
-        print(f"table written to {table.write(Path(args.out))}")
+        meta = {**metadata(), "study": args.name, "set": given}
+        print(f"table written to {save_run(table.data, Path(args.out), meta)}")
 
 
 def _run(args: argparse.Namespace) -> None:
@@ -488,7 +492,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="fix a scene parameter (a swept one is no longer swept)",
     )
     study.add_argument(
-        "--out", metavar="FILE", help="write the whole table (.parquet, else CSV) to FILE"
+        "--out",
+        metavar="FILE",
+        help="write the whole table to FILE as lawbench run does (.parquet, .csv or .feather)",
     )
     _executor_arguments(study, "serial")
     study.set_defaults(run=_study)
