@@ -48,6 +48,8 @@ EXIT_CODES = {
 
 # Cells above which ``lawbench run`` asks for --yes.
 LARGE_GRID = 10_000
+# Cells of a large grid timed for the estimate of its duration.
+ESTIMATE_CELLS = 3
 
 
 class _Parser(argparse.ArgumentParser):
@@ -262,18 +264,21 @@ def _run(args: argparse.Namespace) -> None:
         raise InvalidProblem("run: give a spec file or --laws/--cases/--param")
     out = Path(args.out or f"results.{args.format or 'parquet'}")
     file_format(out, args.format)
-    plan = spec.plan()
-    cells = f"{len(plan.jobs)} cell" + ("s" if len(plan.jobs) != 1 else "")
-    print(f"run: {cells}; {spec.describe()}", flush=True)
-    workers = args.workers or os.cpu_count() or 1
-    if len(plan.jobs) > LARGE_GRID and not args.yes and not args.resume:
-        seconds = estimate_seconds(plan, workers if args.executor != "serial" else 1)
-        raise InvalidProblem(
-            f"run: a grid of {len(plan.jobs)} cells (more than {LARGE_GRID}), about "
-            f"{_duration(seconds)} on {workers} workers: give --yes to run it"
-        )
+    # Counted from the grid's sizes: a grid too large to run is refused before it is built.
+    count = spec.count()
+    print(f"run: {count} cell{'s' if count != 1 else ''}; {spec.describe()}", flush=True)
+    if count > LARGE_GRID and not args.resume:
+        workers = 1 if args.executor == "serial" else args.workers or os.cpu_count() or 1
+        seconds = estimate_seconds(spec.plan(sample=ESTIMATE_CELLS), count, workers)
+        about = f"about {_duration(seconds)} on {workers} worker{'s' if workers != 1 else ''}"
+        print(f"run: {count} cells, {about} ({ESTIMATE_CELLS} cells timed)", flush=True)
+        if not args.yes:
+            raise InvalidProblem(
+                f"run: a grid of {count} cells (more than {LARGE_GRID}), {about}: "
+                "give --yes to run it"
+            )
     table, computed = run(
-        plan,
+        spec.plan(),
         out,
         args.executor,
         args.address,
