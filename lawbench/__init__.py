@@ -30,13 +30,16 @@ from lawbench.verdicts import Claim, Region, Verdict
 __version__ = importlib.metadata.version("lawbench")
 
 # Loaded when first asked for: problem files need scipy.sparse (and h5py for HDF5), fitting
-# needs pandas and scipy.optimize, run tables pandas and pyarrow.
+# needs pandas and scipy.optimize, run tables pandas and pyarrow, figures matplotlib.
 _LAZY = {
     "load_problem": "lawbench.problem_files",
     "save_problem": "lawbench.problem_files",
     "fit": "lawbench.fitting",
     "FitResult": "lawbench.fitting",
     "load_run": "lawbench.runfile",
+    "plot_outcome": "lawbench.plotting",
+    "plot_path": "lawbench.plotting",
+    "plot_sweep": "lawbench.plotting",
 }
 
 
@@ -76,6 +79,9 @@ __all__ = [
     "fit",
     "load_problem",
     "load_run",
+    "plot_outcome",
+    "plot_path",
+    "plot_sweep",
     "run_checks",
     "save_problem",
     "solve",

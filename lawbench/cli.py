@@ -48,6 +48,8 @@ EXIT_CODES = {
 
 # Cells above which ``lawbench run`` asks for --yes.
 LARGE_GRID = 10_000
+# Cells of a large grid timed for the estimate of its duration.
+ESTIMATE_CELLS = 3
 
 
 class _Parser(argparse.ArgumentParser):
@@ -229,6 +231,7 @@ def _report(args: argparse.Namespace) -> None:
 
 
 def _study(args: argparse.Namespace) -> None:
+    from lawbench.runfile import file_format, metadata, save_run
     from lawbench.tables import study_table
 
     if args.list:
@@ -238,10 +241,13 @@ def _study(args: argparse.Namespace) -> None:
     if not args.name:
         raise InvalidProblem("study: give a study's name, or --list")
     given = _assignments(args.set, "--set")
+    if args.out:
+        file_format(Path(args.out))  # a bad extension stops before any cell is computed
     table = study_table(args.name, given, args.executor, args.workers, args.max_seconds)
     print(table.text())
     if args.out:
-        print(f"table written to {table.write(Path(args.out))}")
+        meta = {**metadata(), "study": args.name, "set": given}
+        print(f"table written to {save_run(table.data, Path(args.out), meta)}")
 
 
 def _run(args: argparse.Namespace) -> None:
@@ -258,18 +264,21 @@ def _run(args: argparse.Namespace) -> None:
         raise InvalidProblem("run: give a spec file or --laws/--cases/--param")
     out = Path(args.out or f"results.{args.format or 'parquet'}")
     file_format(out, args.format)
-    plan = spec.plan()
-    cells = f"{len(plan.jobs)} cell" + ("s" if len(plan.jobs) != 1 else "")
-    print(f"run: {cells}; {spec.describe()}", flush=True)
-    workers = args.workers or os.cpu_count() or 1
-    if len(plan.jobs) > LARGE_GRID and not args.yes and not args.resume:
-        seconds = estimate_seconds(plan, workers if args.executor != "serial" else 1)
-        raise InvalidProblem(
-            f"run: a grid of {len(plan.jobs)} cells (more than {LARGE_GRID}), about "
-            f"{_duration(seconds)} on {workers} workers: give --yes to run it"
-        )
+    # Counted from the grid's sizes: a grid too large to run is refused before it is built.
+    count = spec.count()
+    print(f"run: {count} cell{'s' if count != 1 else ''}; {spec.describe()}", flush=True)
+    if count > LARGE_GRID and not args.resume:
+        workers = 1 if args.executor == "serial" else args.workers or os.cpu_count() or 1
+        seconds = estimate_seconds(spec.plan(sample=ESTIMATE_CELLS), count, workers)
+        about = f"about {_duration(seconds)} on {workers} worker{'s' if workers != 1 else ''}"
+        print(f"run: {count} cells, {about} ({ESTIMATE_CELLS} cells timed)", flush=True)
+        if not args.yes:
+            raise InvalidProblem(
+                f"run: a grid of {count} cells (more than {LARGE_GRID}), {about}: "
+                "give --yes to run it"
+            )
     table, computed = run(
-        plan,
+        spec.plan(),
         out,
         args.executor,
         args.address,
@@ -488,7 +497,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="fix a scene parameter (a swept one is no longer swept)",
     )
     study.add_argument(
-        "--out", metavar="FILE", help="write the whole table (.parquet, else CSV) to FILE"
+        "--out",
+        metavar="FILE",
+        help="write the whole table to FILE as lawbench run does (.parquet, .csv or .feather)",
     )
     _executor_arguments(study, "serial")
     study.set_defaults(run=_study)

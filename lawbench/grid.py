@@ -27,6 +27,8 @@ values; ``size`` > 1 draws vectors). Rows are the Cartesian product in the order
 cases, then laws, then parameters, then options, then transforms. Every row is checked before
 any work: an unknown name or a value out of range raises `InvalidProblem`. A row is a
 `lawbench.study.Job`; `RunSpec.plan` gives the executor's plan (`lawbench.runner.run`).
+`RunSpec.count` counts the rows from the grid's sizes and `RunSpec.sample` builds a few of them
+alone, so a grid of millions of rows is sized and timed before it is built.
 """
 
 from __future__ import annotations
@@ -34,11 +36,12 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
@@ -48,6 +51,10 @@ from lawbench.errors import InvalidProblem
 from lawbench.law import LAWS
 from lawbench.study import Job, Plan
 from lawbench.transforms import parse
+
+if TYPE_CHECKING:
+    from lawbench.case import Case
+    from lawbench.law import Law
 
 
 @dataclass(frozen=True)
@@ -98,32 +105,59 @@ class RunSpec:
 
     def rows(self) -> list[Job]:
         """Every row, in order, each checked against its law and case."""
-        return [
-            job
-            for number, grid in enumerate(self.grids)
-            for job in _expand(grid, self.seed, number)
-        ]
+        return [job for block in self._blocks() for job in block.rows()]
+
+    def count(self) -> int:
+        """The number of rows, from each grid's sizes, without building a row.
+
+        Per grid, the sum over its cases and laws of parameter sets x option sets x transforms,
+        where a generator's grid points are counted, not drawn: a grid of millions of rows is
+        counted as fast as one of ten.
+        """
+        return sum(block.size for block in self._blocks())
+
+    def sample(self, count: int) -> list[Job]:
+        """``count`` rows spread evenly over the grid (all of them when there are fewer).
+
+        Each row is built alone, from its position: the rows around it are not built.
+        """
+        blocks = list(self._blocks())
+        total = sum(block.size for block in blocks)
+        wanted = sorted({k * total // count for k in range(count)}) if total else []
+        jobs, start = [], 0
+        for block in blocks:
+            jobs += [block.row(k - start) for k in wanted if start <= k < start + block.size]
+            start += block.size
+        return jobs
+
+    def _blocks(self) -> Iterator[_Block]:
+        for number, grid in enumerate(self.grids):
+            yield from _blocks(grid, self.seed, number)
 
     def describe(self) -> str:
-        """The grid as it was read, in one line: names, and each parameter's grid points."""
+        """The grid as it was read, in one line: names, and each parameter's grid points.
+
+        A generator's grid points are shown as the rows draw them; only those shown are
+        computed.
+        """
         parts = []
         for number, grid in enumerate(self.grids):
             text = [f"laws {_listed(grid.get('laws', ['*']))}"]
             text.append(f"cases {_listed(grid.get('cases', ['*']))}")
-            for kind in ("params", "options"):
-                entries = dict(grid.get(kind, {}))
-                if kind == "options":  # per law: {law: {option: values}}
-                    entries = {f"{law}.{k}": v for law, o in entries.items() for k, v in o.items()}
-                for name, spec in entries.items():
-                    points = values(spec, self.seed, (number, kind, name))
-                    few = (
-                        points
-                        if len(points) <= SHOWN
-                        else [*points[: SHOWN - 1], "...", points[-1]]
-                    )
-                    shown = " | ".join(_shown(p) for p in few)
-                    plural = "s" if len(points) != 1 else ""
-                    text.append(f"{name} = {shown} ({len(points)} grid point{plural})")
+            entries = [
+                (name, ("param", name), spec) for name, spec in grid.get("params", {}).items()
+            ]
+            entries += [
+                (f"{law}.{name}", ("option", law, name), spec)
+                for law, options in grid.get("options", {}).items()
+                for name, spec in options.items()
+            ]
+            for name, where, spec in entries:
+                points = grid_points(spec, self.seed, (number, *where))
+                few = points if len(points) <= SHOWN else [*points[: SHOWN - 1], "...", points[-1]]
+                shown = " | ".join(_shown(p) for p in few)
+                plural = "s" if len(points) != 1 else ""
+                text.append(f"{name} = {shown} ({len(points)} grid point{plural})")
             if grid.get("examples"):
                 text.append("each case's examples")
             if grid.get("transforms"):
@@ -131,10 +165,14 @@ class RunSpec:
             parts.append(f"grid {number}: " + "; ".join(text))
         return " / ".join(parts)
 
-    def plan(self) -> Plan:
-        """The executor's plan: every row, the checks, their settings; no measures."""
+    def plan(self, sample: int | None = None) -> Plan:
+        """The executor's plan: every row (or a `sample` of them), the checks, their settings.
+
+        A plan has no measures.
+        """
         settings = {"continuity_sizes": list(self.continuity_sizes)}
-        return Plan("", self.rows(), tuple(self.checks), settings)
+        jobs = self.rows() if sample is None else self.sample(sample)
+        return Plan("", jobs, tuple(self.checks), settings)
 
 
 # Grid points of one parameter the echoed grid shows before it elides the middle ones.
@@ -185,13 +223,63 @@ def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
     return list(names)
 
 
-def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
+@dataclass(frozen=True)
+class _Block:
+    """The rows of one law on one case of a grid: parameter sets x option sets x transforms."""
+
+    number: int
+    law: Law
+    case: Case
+    law_name: str
+    case_name: str
+    parameter_sets: Sequence[Mapping[str, Any]]
+    option_sets: Sequence[Mapping[str, Any]]
+    transforms: Sequence[str]
+
+    @property
+    def size(self) -> int:
+        """The number of rows, counted without building them."""
+        return len(self.parameter_sets) * len(self.option_sets) * len(self.transforms)
+
+    def rows(self) -> Iterator[Job]:
+        """Every row, in order, each checked against its law and case."""
+        for params in self.parameter_sets:
+            for options in self.option_sets:
+                self._check(params, options)
+                for transform in self.transforms:
+                    yield self._job(params, options, transform)
+
+    def row(self, index: int) -> Job:
+        """Row ``index`` (in the order of `rows`), built alone and checked."""
+        rest, transform = divmod(index, len(self.transforms))
+        params, options = divmod(rest, len(self.option_sets))
+        chosen = self.parameter_sets[params], self.option_sets[options]
+        self._check(*chosen)
+        return self._job(*chosen, self.transforms[transform])
+
+    def _job(self, params: Mapping[str, Any], options: Mapping[str, Any], transform: str) -> Job:
+        return Job(self.law_name, self.case_name, dict(params), dict(options), transform)
+
+    def _check(self, params: Mapping[str, Any], options: Mapping[str, Any]) -> None:
+        try:
+            self.case.parameters(**params)
+            self.law.option_values(dict(options))
+        except InvalidProblem as exc:
+            raise InvalidProblem(
+                f"spec grid {self.number}, {self.law_name} on {self.case_name}: {exc}"
+            ) from None
+
+
+def _blocks(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[_Block]:
+    """The blocks of a grid, one per case and law in row order; no row is built."""
     every_law = grid.get("laws", ["*"]) in (["*"], "*")
     laws, cases = _names(grid, "laws", LAWS), _names(grid, "cases", CASES)
-    param_values = {
-        name: values(spec, seed, (number, "param", name))
-        for name, spec in dict(grid.get("params", {})).items()
-    }
+    param_points = Product(
+        {
+            name: grid_points(spec, seed, (number, "param", name))
+            for name, spec in dict(grid.get("params", {})).items()
+        }
+    )
     option_grids = dict(grid.get("options", {}))
     for law in option_grids:
         LAWS.get(law)
@@ -204,26 +292,20 @@ def _expand(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[Job]:
             law = LAWS.get(law_name)
             if every_law and not law.tags.covers(case.requires):
                 continue
-            option_values = {
-                name: values(spec, seed, (number, "option", law_name, name))
-                for name, spec in dict(option_grids.get(law_name, {})).items()
-            }
+            option_points = Product(
+                {
+                    name: grid_points(spec, seed, (number, "option", law_name, name))
+                    for name, spec in dict(option_grids.get(law_name, {})).items()
+                }
+            )
             parameter_sets = (
                 [dict(p) for p in case.examples.values()]
                 if grid.get("examples", False)
-                else list(_product(param_values))
+                else param_points
             )
-            for params in parameter_sets:
-                for options in _product(option_values):
-                    try:
-                        case.parameters(**params)
-                        law.option_values(options)
-                    except InvalidProblem as exc:
-                        raise InvalidProblem(
-                            f"spec grid {number}, {law_name} on {case_name}: {exc}"
-                        ) from None
-                    for transform in transforms:
-                        yield Job(law_name, case_name, params, options, transform)
+            yield _Block(
+                number, law, case, law_name, case_name, parameter_sets, option_points, transforms
+            )
 
 
 def _listed(names: Any) -> str:
@@ -279,41 +361,132 @@ def _point(name: str, item: str) -> Any:
     return value if isinstance(value, int | float | list) else item
 
 
-def _product(choices: Mapping[str, list[Any]]) -> Iterator[dict[str, Any]]:
-    names = list(choices)
-    for combination in itertools.product(*(choices[name] for name in names)):
-        yield dict(zip(names, combination, strict=True))
+class Product(Sequence[dict[str, Any]]):
+    """The Cartesian product of named grid points, in ``itertools.product`` order.
+
+    The last name varies fastest. Its length and any one entry come without the others.
+    """
+
+    def __init__(self, axes: Mapping[str, Sequence[Any]]) -> None:
+        self.axes = dict(axes)
+
+    def __len__(self) -> int:
+        return math.prod(len(points) for points in self.axes.values())
+
+    @overload
+    def __getitem__(self, index: int) -> dict[str, Any]: ...
+    @overload
+    def __getitem__(self, index: slice) -> list[dict[str, Any]]: ...
+    def __getitem__(self, index: int | slice) -> dict[str, Any] | list[dict[str, Any]]:
+        if isinstance(index, slice):
+            return [self[k] for k in range(*index.indices(len(self)))]
+        index = _position(index, len(self))
+        chosen = {}
+        for name, points in reversed(self.axes.items()):
+            index, k = divmod(index, len(points))
+            chosen[name] = points[k]
+        return {name: chosen[name] for name in self.axes}
+
+    def __iter__(self) -> Iterator[dict[str, Any]]:
+        names = list(self.axes)
+        for combination in itertools.product(*self.axes.values()):
+            yield dict(zip(names, combination, strict=True))
 
 
-def values(spec: Any, seed: int, where: tuple) -> list[Any]:
-    """The values a grid entry stands for (see the module docstring)."""
+class Generated(Sequence[Any]):
+    """The grid points of a generator (``range``, ``logrange``, ``random``), drawn on demand.
+
+    Its length is the generator's count; an entry is computed alone (a random draw from the
+    generator's stream advanced to it), equal to the same entry of the whole list.
+
+    Raises
+    ------
+    InvalidProblem
+        For an unknown generator or a malformed one, naming its key.
+    """
+
+    KINDS = ("range", "logrange", "random")
+
+    def __init__(self, spec: Mapping[str, Any], seed: int, where: tuple) -> None:
+        self.kind = next((kind for kind in self.KINDS if kind in spec), None)
+        if self.kind is None:
+            raise InvalidProblem(f"spec {_key(where)}: unknown value generator {dict(spec)}")
+        try:
+            start, stop, count = spec[self.kind]
+            self.start, self.stop, self.count = float(start), float(stop), int(count)
+            self.width = int(spec.get("size", 1))
+        except (TypeError, ValueError) as exc:
+            raise InvalidProblem(
+                f"spec {_key(where)}: bad value generator {dict(spec)} ({exc})"
+            ) from None
+        if self.count < 0 or self.width < 1:
+            raise InvalidProblem(
+                f"spec {_key(where)}: bad value generator {dict(spec)} (a negative count or size)"
+            )
+        self.log = bool(spec.get("log", False))
+        digest = hashlib.sha1("/".join(str(part) for part in where).encode()).digest()
+        self.seed = [seed, int.from_bytes(digest[:8], "little")]
+
+    def __len__(self) -> int:
+        return self.count
+
+    @overload
+    def __getitem__(self, index: int) -> Any: ...
+    @overload
+    def __getitem__(self, index: slice) -> list[Any]: ...
+    def __getitem__(self, index: int | slice) -> Any:
+        if isinstance(index, slice):
+            return [self[k] for k in range(*index.indices(len(self)))]
+        index = _position(index, self.count)
+        if self.kind == "random":
+            return self._draws(index, 1)[0]
+        # np.linspace's entry index: start + index * step, the last one exactly stop.
+        if index == self.count - 1 and index > 0:
+            point = self.stop
+        else:
+            point = index * ((self.stop - self.start) / max(1, self.count - 1)) + self.start
+        return float(np.power(10.0, point)) if self.kind == "logrange" else point
+
+    def __iter__(self) -> Iterator[Any]:
+        if self.kind == "range":
+            return iter(np.linspace(self.start, self.stop, self.count).tolist())
+        if self.kind == "logrange":
+            return iter(np.logspace(self.start, self.stop, self.count).tolist())
+        return iter(self._draws(0, self.count))
+
+    def _draws(self, first: int, count: int) -> list[Any]:
+        """Draws ``first`` to ``first + count - 1`` of the generator's seeded stream."""
+        rng = np.random.default_rng(self.seed)
+        # A uniform draw takes one 64-bit output of PCG64: skip those of the draws before.
+        rng.bit_generator.advance(first * self.width)
+        if self.log:
+            low, high = np.log10(self.start), np.log10(self.stop)
+            draws = 10 ** rng.uniform(low, high, (count, self.width))
+        else:
+            draws = rng.uniform(self.start, self.stop, (count, self.width))
+        return [row[0] if self.width == 1 else row for row in draws.tolist()]
+
+
+def _position(index: int, length: int) -> int:
+    """``index`` as a position in a sequence of ``length`` (negative from the end)."""
+    position = index + length if index < 0 else index
+    if not 0 <= position < length:
+        raise IndexError(f"grid point {index} of {length}")
+    return position
+
+
+def grid_points(spec: Any, seed: int, where: tuple) -> Sequence[Any]:
+    """The grid points a grid entry stands for (see the module docstring), not yet drawn."""
     if isinstance(spec, list):
         return spec
     if not isinstance(spec, Mapping):
         return [spec]
-    label = "/".join(str(part) for part in where)
-    try:
-        if "range" in spec:
-            start, stop, count = spec["range"]
-            return np.linspace(start, stop, int(count)).tolist()
-        if "logrange" in spec:
-            start, stop, count = spec["logrange"]
-            return np.logspace(start, stop, int(count)).tolist()
-        if "random" in spec:
-            low, high, count = spec["random"]
-            size = int(spec.get("size", 1))
-            digest = hashlib.sha1(label.encode()).digest()
-            rng = np.random.default_rng([seed, int.from_bytes(digest[:8], "little")])
-            if spec.get("log", False):
-                draws = 10 ** rng.uniform(np.log10(low), np.log10(high), (int(count), size))
-            else:
-                draws = rng.uniform(low, high, (int(count), size))
-            return [row[0] if size == 1 else row for row in draws.tolist()]
-    except (TypeError, ValueError) as exc:
-        raise InvalidProblem(
-            f"spec {_key(where)}: bad value generator {dict(spec)} ({exc})"
-        ) from None
-    raise InvalidProblem(f"spec {_key(where)}: unknown value generator {dict(spec)}")
+    return Generated(spec, seed, where)
+
+
+def values(spec: Any, seed: int, where: tuple) -> list[Any]:
+    """The values a grid entry stands for (see the module docstring)."""
+    return list(grid_points(spec, seed, where))
 
 
 def _key(where: tuple) -> str:

@@ -12,6 +12,7 @@ from lawbench.problem import ImpactProblem
 
 if TYPE_CHECKING:
     import pandas as pd
+    from matplotlib.axes import Axes
 
 
 @dataclass(frozen=True, eq=False)
@@ -34,6 +35,8 @@ class Outcome:
         Formulation used, iterations or steps, solver status, wall time (``wall_time_s``).
     path : dict or None
         On request, quantities along the impact variable, for plots.
+    v_minus : array (n,) or None
+        Pre-impact generalized velocity, the problem's ``v`` (None when not given).
     """
 
     v_plus: np.ndarray
@@ -44,6 +47,7 @@ class Outcome:
     status: str = "ok"
     diagnostics: dict[str, Any] = field(default_factory=dict)
     path: dict[str, np.ndarray] | None = None
+    v_minus: np.ndarray | None = None
 
     def to_frame(self) -> pd.DataFrame:
         """The outcome as a tidy frame: one row per quantity and index (v_plus, Pn, Pt, energy).
@@ -67,6 +71,23 @@ class Outcome:
         formulation = self.diagnostics.get("formulation", "")
         head = f"<p>Outcome ({self.status}; {formulation})</p>"
         return head + self.to_frame().to_html(index=False)
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Bars of the pre- and post-impact velocity per coordinate (`lawbench.plot_outcome`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure's axes when None.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
+        from lawbench.plotting import plot_outcome
+
+        return plot_outcome(self, ax)
 
     @property
     def dT(self) -> float:
@@ -105,4 +126,5 @@ class Outcome:
             status=status,
             diagnostics=dict(diagnostics or {}),
             path=path,
+            v_minus=np.asarray(problem.v, dtype=float),
         )

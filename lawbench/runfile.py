@@ -187,6 +187,38 @@ def write_table(table: pd.DataFrame, path: Path, meta: Mapping[str, Any]) -> Non
     os.replace(temporary, path)
 
 
+def save_run(records: pd.DataFrame, path: Path, meta: Mapping[str, Any]) -> Path:
+    """Write a run's records as its tidy table at ``path``; return ``path``.
+
+    The one writer of run tables (``lawbench run``, ``lawbench study --out``): `tidy` makes
+    the table and its layout, `write_table` writes both with ``meta``, so that `load_run` reads
+    any of them back. The folder of ``path`` is created when missing.
+
+    Parameters
+    ----------
+    records : pandas.DataFrame
+        One `lawbench.record.Record` row per cell, in cell order.
+    path : Path
+        A ``.parquet``, ``.csv`` or ``.feather`` file.
+    meta : mapping
+        The run's metadata (`metadata`), with anything else to keep beside it.
+
+    Raises
+    ------
+    InvalidProblem
+        For an unknown extension, or a file that cannot be written.
+    """
+    path = Path(path)
+    file_format(path)
+    tidied, layout = tidy(records)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_table(tidied, path, {**meta, **layout})
+    except OSError as exc:
+        raise InvalidProblem(f"--out {path}: cannot write ({exc.strerror})") from None
+    return path
+
+
 def _wide(layout: Mapping[str, Any]) -> list[str]:
     """The list columns of a tidy table: the outcome's vectors and the vector parameters."""
     return [*layout.get("vectors", []), *layout.get("lists", [])]
@@ -386,8 +418,7 @@ class Store:
             return table
         table = table.sort_values("index").reset_index(drop=True)
         if len(table) == total and (self.chunks() or not self.out.exists()):
-            tidied, layout = tidy(table)
-            write_table(tidied, self.out, {**meta, **layout})
+            save_run(table, self.out, meta)
             for path in self.parts.iterdir():
                 path.unlink()
             self.parts.rmdir()

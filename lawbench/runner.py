@@ -328,21 +328,19 @@ def run_many(
         ]
 
 
-def estimate_seconds(plan: Plan, workers: int, sample: int = 3) -> float:
-    """Wall time ``plan`` would take on ``workers`` processes, from a few cells timed here.
+def estimate_seconds(sample: Plan, cells: int, workers: int) -> float:
+    """Wall time ``cells`` cells would take on ``workers`` processes, from ``sample`` timed here.
 
-    The cells timed are spread evenly over the plan; a grid whose cells differ much in cost
-    (a sweep of an accuracy knob) makes this a rough figure.
+    ``sample`` holds a few cells spread over the grid (`lawbench.grid.RunSpec.plan`); a grid
+    whose cells differ much in cost (a sweep of an accuracy knob) makes this a rough figure.
     """
-    jobs = plan.jobs
-    if not jobs:
+    if not sample.jobs:
         return 0.0
-    picked = jobs[:: max(1, len(jobs) // sample)][:sample]
     start = time.perf_counter()
-    for index, job in enumerate(picked):
-        compute(Task(index, job, plan.name, plan.checks, plan.settings, plan.measures))
-    per_cell = (time.perf_counter() - start) / len(picked)
-    return per_cell * len(jobs) / max(1, workers)
+    for index, job in enumerate(sample.jobs):
+        compute(Task(index, job, sample.name, sample.checks, sample.settings, sample.measures))
+    per_cell = (time.perf_counter() - start) / len(sample.jobs)
+    return per_cell * cells / max(1, workers)
 
 
 def collect(plan: Plan, executor: Executor) -> pd.DataFrame:

@@ -5,14 +5,14 @@ A study's table (`lawbench.runner.collect`) has one row per cell with every reco
 (and scene, when it has several), each swept parameter as a typed column, the transform's
 value, the options swept, the measured columns (a mapping measure spread over one column per
 key) and the verdict, for every cell that gave an answer; the cells that did not are notes,
-one per law and reason, each with the count of its cells.
+one per law and reason, each with the count of its cells. ``--out`` writes the full records
+in the tidy format of a run (`lawbench.runfile.save_run`), which `lawbench.load_run` reads.
 """
 
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import pandas as pd
@@ -81,25 +81,6 @@ class Table:
         lines = [f"{self.study.name}: {self.study.title}", ""]
         lines.append(body if len(frame) else "(no cell gave an answer)")
         return "\n".join([*lines, *(f"note: {note}" for note in self.notes)])
-
-    def write(self, path: Path) -> Path:
-        """Write the full table to ``path`` (Parquet for ``.parquet``, else CSV); return it.
-
-        Raises
-        ------
-        InvalidProblem
-            When the file cannot be written.
-        """
-        path = Path(path)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            if path.suffix == ".parquet":
-                self.data.to_parquet(path, index=False)
-            else:
-                self.data.to_csv(path, index=False)
-        except OSError as exc:
-            raise InvalidProblem(f"--out {path}: cannot write ({exc.strerror})") from None
-        return path
 
 
 def _plain(value: Any) -> Any:

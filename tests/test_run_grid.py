@@ -6,6 +6,7 @@ import re
 import subprocess
 import sys
 import tomllib
+import tracemalloc
 from pathlib import Path
 
 import pandas as pd
@@ -107,6 +108,104 @@ def test_a_large_grid_states_its_size_and_needs_yes(tmp_path):
     assert "a grid of 10001 cells" in done.stderr and "give --yes" in done.stderr
     assert "0 | 0.0001 | 0.0002 | 0.0003 | 0.0004 | ... | 1 (10001 grid points)" in done.stdout
     assert not (tmp_path / "big.parquet").exists()
+
+
+def test_a_grid_of_a_hundred_million_cells_is_refused_before_it_is_built(
+    tmp_path, monkeypatch, capsys
+):
+    """Counted from the grid's sizes: no row is built, no generator drawn whole, and the
+    memory taken stays far below what 10^7 grid points alone would take (80 MB as floats)."""
+    from lawbench import cli, grid
+
+    def built(*args):
+        pytest.fail("the grid was built")
+
+    monkeypatch.setattr(grid.RunSpec, "rows", built)
+    monkeypatch.setattr(grid.Generated, "__iter__", built)
+    monkeypatch.setattr(grid.Product, "__iter__", built)
+    monkeypatch.chdir(tmp_path)
+    Path("huge.toml").write_text(
+        '[[grid]]\nlaws = ["moreau"]\ncases = ["three_ball_chain"]\n'
+        "params = { e = { range = [0, 1, 10000000] } }\n"
+        "options = { moreau = { tol = { logrange = [-12, -3, 10] } } }\n"
+    )
+    tracemalloc.start()
+    try:
+        code = cli.main(["run", "huge.toml", "--executor", "serial", "--out", "huge.parquet"])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    out, err = capsys.readouterr()
+    assert code == 2, err
+    assert "a grid of 100000000 cells" in err and "give --yes" in err
+    first = out.splitlines()[0]
+    assert first.startswith("run: 100000000 cells; grid 0: laws moreau; cases three_ball_chain")
+    assert "e = 0 | 1e-07 | 2e-07 | 3e-07 | 4e-07 | ... | 1 (10000000 grid points)" in first
+    assert peak < 40e6
+    assert not Path("huge.parquet").exists()
+
+
+GRIDS = [
+    {"grid": [{"laws": ["newton", "moreau"], "cases": ["three_ball_chain", "two_balls_wall"]}]},
+    {"grid": [{"cases": ["two_balls_wall"], "examples": True, "transforms": ["", "duplicated"]}]},
+    {
+        "grid": [
+            {
+                "cases": ["three_ball_chain"],
+                "params": {"e": {"range": [0, 1, 4]}, "masses": {"random": [1, 2, 3], "size": 3}},
+                "options": {"moreau": {"tol": {"logrange": [-9, -6, 2]}}},
+            },
+            {"laws": ["sequential"], "cases": ["*"], "params": {"e": []}},
+        ]
+    },
+]
+
+
+@pytest.mark.parametrize("data", GRIDS)
+def test_the_count_and_the_sample_agree_with_the_rows(data):
+    spec = RunSpec.from_dict(data)
+    rows = spec.rows()
+    assert spec.count() == len(rows)
+    wanted = sorted({k * len(rows) // 5 for k in range(5)})
+    assert spec.sample(5) == [rows[k] for k in wanted]
+
+
+@pytest.mark.parametrize(
+    "generator",
+    [
+        {"range": [0, 1, 10001]},
+        {"range": [-3, 7, 13]},
+        {"range": [2, 2, 4]},
+        {"range": [1, 5, 1]},
+        {"logrange": [-12, -4, 101]},
+        {"random": [0.5, 2.0, 17], "log": True, "size": 3},
+        {"random": [0, 1, 50]},
+    ],
+)
+def test_a_grid_point_computed_alone_is_the_same_as_in_the_whole_list(generator):
+    from lawbench.grid import Generated
+
+    points = Generated(generator, 7, (0, "param", "e"))
+    whole = list(points)
+    assert len(whole) == len(points)
+    assert [points[k] for k in range(len(points))] == whole
+    assert points[-1] == whole[-1]
+
+
+def test_the_echoed_grid_shows_the_random_draws_the_rows_use():
+    spec = RunSpec.from_dict(
+        {
+            "grid": [
+                {
+                    "laws": ["newton"],
+                    "cases": ["three_ball_chain"],
+                    "params": {"e": {"random": [0, 1, 3]}},
+                }
+            ]
+        }
+    )
+    drawn = [job.params["e"] for job in spec.rows()]
+    assert " | ".join(f"{e:g}" for e in drawn) + " (3 grid points)" in spec.describe()
 
 
 @pytest.mark.parametrize(

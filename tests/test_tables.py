@@ -173,12 +173,43 @@ def test_the_command_writes_the_table_and_prints_the_view(tmp_path):
     out = tmp_path / "sub" / "sphere.csv"
     result = lawbench_command("study", "sphere_wall", "--set", "angle=30", "--out", str(out))
     assert result.returncode == 0, result.stderr
-    written = pd.read_csv(out)
+    written = lawbench.load_run(out)
     assert len(written) == 3 and set(written["verdict"]) == {"holds"}
     assert {"reproducer", "exit_status", "ut_plus", "energy_gain_verdict"} <= set(written)
     assert "impulse_ratio" in result.stdout and str(out) in result.stdout
     again = lawbench_command(*written["reproducer"][0].split()[1:], "--json")
     assert again.returncode == int(written["exit_status"][0])
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".csv", ".feather"])
+def test_a_study_is_written_in_the_tidy_format_of_a_run(tmp_path, suffix):
+    """One writer for runs and studies: typed parameter columns, list columns for the vectors
+    (and the vector parameter ``spin``), categorical verdicts, the study in the metadata."""
+    from lawbench.cli import main
+
+    out = tmp_path / f"sphere{suffix}"
+    assert main(["study", "sphere_wall", "--set", "angle=30", "--out", str(out)]) == 0
+    table = lawbench.load_run(out)
+    assert table["angle"].dtype == float and list(table["angle"]) == [30.0] * 3
+    assert all(len(v) == 3 for v in table["spin"])
+    assert all(len(v) == 6 for v in table["v_plus"]) and all(len(v) == 1 for v in table["Pn"])
+    assert isinstance(table["verdict"].dtype, pd.CategoricalDtype)
+    assert list(table["verdict"].cat.categories) == [str(v) for v in Verdict]
+    assert table.attrs["lawbench"]["study"] == "sphere_wall"
+    assert table.attrs["lawbench"]["set"] == {"angle": "30"}
+    assert "numpy" in table.attrs["lawbench"]["versions"]
+    if suffix == ".csv":
+        assert {"v_plus_0", "v_plus_5", "Pn_0"} <= set(pd.read_csv(out).columns)
+
+
+def test_a_study_refuses_an_unknown_extension_before_any_work(tmp_path, capsys, monkeypatch):
+    from lawbench import cli, tables
+
+    monkeypatch.setattr(tables, "study_table", lambda *a, **k: pytest.fail("the study ran"))
+    out = tmp_path / "sphere.txt"
+    assert cli.main(["study", "sphere_wall", "--out", str(out)]) == 2
+    assert "unknown extension '.txt'" in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_table_is_study_and_list_names_every_study():

@@ -1,8 +1,9 @@
-"""Shared figure helpers: figures without pyplot, law styles, log floors, coordinate units."""
+"""Shared figure helpers: figures without pyplot, law styles, log floors, units and labels."""
 
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -55,3 +56,11 @@ def by_unit(coordinates: list[str]) -> dict[str, list[int]]:
     for k, name in enumerate(coordinates):
         groups.setdefault(unit(name), []).append(k)
     return groups
+
+
+def unit_label(name: str, units: Mapping[str, str]) -> str:
+    """``name [unit]`` (``[-]`` dimensionless); a vector's component takes its measure's."""
+    unit = units.get(name, units.get(name.split("[", 1)[0]))
+    if unit is None:
+        return f"{name} [unit not stated]"
+    return f"{name} [{unit or '-'}]"

@@ -20,6 +20,7 @@ import pandas as pd
 
 from lawbench.report import plots
 from lawbench.report.page import Figure, Section, Table, number
+from lawbench.report.plots import unit_label
 from lawbench.report.runs import Context, axis_value, parsed
 
 ANCHOR, TITLE, VIEWS = "sweeps", "Sweeps of the sources' systems", ("sweep",)
@@ -71,14 +72,6 @@ def _units(ctx: Context, case: str, axis: str, declared: Mapping[str, str]) -> d
     if axis in specs:
         units[axis] = specs[axis].unit
     return units
-
-
-def unit_label(name: str, units: Mapping[str, str]) -> str:
-    """``name [unit]`` (``[-]`` dimensionless); a vector's component takes its measure's."""
-    unit = units.get(name, units.get(name.split("[", 1)[0]))
-    if unit is None:
-        return f"{name} [unit not stated]"
-    return f"{name} [{unit or '-'}]"
 
 
 def _decades(values: pd.Series) -> float:
