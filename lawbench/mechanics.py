@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from lawbench.problem import ImpactProblem
+from lawbench.problem import SMALL, SPARSE_SHARE, ImpactProblem
+
+if TYPE_CHECKING:
+    import scipy.sparse
 
 
 def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
@@ -74,3 +79,19 @@ def energy_shares(problem: ImpactProblem, v: np.ndarray) -> dict[str, float]:
         own = kinetic_energy(problem.M[np.ix_(idx, idx)], v[idx])
         shares[name] = own / total if total > 0 else 0.0
     return shares
+
+
+def for_products(A: np.ndarray) -> np.ndarray | scipy.sparse.csr_matrix:
+    """``A`` in the form its matrix-vector products are cheapest in.
+
+    A large matrix that is mostly zeros (a chain's Jacobian or Delassus matrix: banded) as a
+    CSR matrix, whose products cost O(nnz) instead of O(rows x columns); any other as given.
+    The integrating laws evaluate such products at every stage of every step.
+    """
+    import scipy.sparse  # on first use: a closed-form law imports no sparse algebra
+
+    if scipy.sparse.issparse(A):
+        return scipy.sparse.csr_matrix(A)
+    if A.shape[0] > SMALL and np.count_nonzero(A) <= SPARSE_SHARE * A.size:
+        return scipy.sparse.csr_matrix(A)
+    return A

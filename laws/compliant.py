@@ -51,6 +51,7 @@ from lawbench.claims import keeps_energy, never_creates_energy
 from lawbench.errors import NotApplicable
 from lawbench.integrator import EventIntegrator
 from lawbench.law import LAWS, Law
+from lawbench.mechanics import for_products
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
 from lawbench.spec import Spec
@@ -173,7 +174,8 @@ class _Integration:
         )
         self.e = problem.restitution("newton")
         self.given_damping = np.array([c.damping for c in contacts])
-        self.B = problem.solve_mass(problem.Wn)
+        self.B = for_products(problem.solve_mass(problem.Wn))
+        self.WnT = for_products(problem.Wn.T)
         G = np.diag(problem.delassus)
         self.V = float(max(np.abs(problem.un).max(), 1e-300))
         indentation = ((self.n + 1) * self.V**2 / (2 * self.k * G)) ** (1 / (self.n + 1))
@@ -233,7 +235,7 @@ class _Integration:
     def physical(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         m = self.problem.m
         g, v = self.L * y[:m], self.V * y[m : m + self.problem.n]
-        return g, v, self.problem.Wn.T @ v
+        return g, v, self.WnT @ v
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         g, _, un = self.physical(y)

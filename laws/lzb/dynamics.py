@@ -33,6 +33,7 @@ import numpy as np
 
 from lawbench.errors import SolverFailure
 from lawbench.integrator import EventIntegrator
+from lawbench.mechanics import for_products
 from lawbench.problem import ImpactProblem
 
 IDLE, COMPRESSION, EXPANSION = 0, 1, 2
@@ -142,7 +143,7 @@ class EnergeticImpact:
         self.L = float(indentation.min())
         self.tau0 = self.L / self.V
         self.I = self.V / float(G.max())
-        self.C = C / float(G.max())
+        self.C = for_products(C / float(G.max()))
         self.k = self.K * self.L**self.eta * self.tau0 / self.I
         self.k_energy = self.k / (self.eta + 1)
         self.u0 = u0 / self.V
