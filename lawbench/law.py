@@ -21,7 +21,7 @@ from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.mechanics import separating_contacts
 from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
+from lawbench.problem import ImpactProblem, all_finite
 from lawbench.registry import Registry
 from lawbench.spec import Spec
 from lawbench.tags import Tags
@@ -118,9 +118,9 @@ class Law(ABC):
             )
         closed = problem.closed
         start = time.perf_counter()
-        if closed.all() or self.follows_gaps:
+        if problem.closed_count == problem.m or self.follows_gaps:
             outcome = self._resolve(problem, values)
-        elif closed.any():
+        elif problem.closed_count:
             outcome = _embed(
                 self._resolve(problem.select_contacts(closed), values), closed, problem
             )
@@ -131,7 +131,7 @@ class Law(ABC):
         if problem.Wt is not None and outcome.Pt.size == 0:
             outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
         for field in ("v_plus", "Pn", "Pt", "T_plus"):
-            if not np.all(np.isfinite(getattr(outcome, field))):
+            if not all_finite(np.asarray(getattr(outcome, field))):
                 raise SolverFailure(f"{self.name}: non-finite {field} {getattr(outcome, field)}")
         outcome.diagnostics["options"] = values
         if separating:

@@ -12,6 +12,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import NoReturn
 
 import numpy as np
 
@@ -22,6 +23,17 @@ RESTITUTION_KINDS = ("newton", "poisson", "energy")
 SMALL = 64
 # A matrix with at most this share of non-zero entries is multiplied as a sparse one.
 SPARSE_SHARE = 0.05
+# A closed contact separates when its gap rate exceeds this fraction of the largest rate.
+SEPARATING = 1e-12
+
+
+def all_finite(array: np.ndarray) -> bool:
+    """Whether every entry of ``array`` is finite.
+
+    An infinite or NaN entry makes the sum non-finite, so a finite sum settles it in one
+    reduction; only a non-finite sum (which overflow can also give) is looked at entry by entry.
+    """
+    return math.isfinite(array.sum()) or bool(np.isfinite(array).all())
 
 
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
@@ -116,7 +128,7 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
     if array.shape != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
-    if not np.isfinite(array).all():
+    if not all_finite(array):
         index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
         raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
     array.flags.writeable = False
@@ -183,35 +195,23 @@ class ImpactProblem:
             if d not in (1, 2):
                 raise InvalidProblem(f"Wt has shape {np.shape(self.Wt)}, expected ({n}, {m}*d)")
             set_(self, "Wt", _matrix("Wt", self.Wt, (n, m * d)))
-        gaps = np.zeros(m) if self.gaps is None else self.gaps
-        set_(self, "gaps", _matrix("gaps", gaps, (m,)))
-        if (self.gaps < 0).any():
-            j = int(np.argmax(self.gaps < 0))
-            raise InvalidProblem(f"gaps[{j}] = {self.gaps[j]:g}: must be >= 0")
+        if self.gaps is None:
+            gaps = np.zeros(m)
+            gaps.flags.writeable = False
+        else:
+            gaps = _matrix("gaps", self.gaps, (m,))
+            if (gaps < 0).any():
+                j = int(np.argmax(gaps < 0))
+                raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
+        set_(self, "gaps", gaps)
         bodies = {str(k): tuple(int(i) for i in idx) for k, idx in dict(self.bodies).items()}
         for name, idx in bodies.items():
             if any(i < 0 or i >= n for i in idx):
                 raise InvalidProblem(f"bodies[{name!r}] = {idx}: indices must lie in [0, {n})")
         set_(self, "bodies", bodies)
-        asymmetry = np.abs(self.M - self.M.T).max()
-        if asymmetry > 1e-12 * np.abs(self.M).max():
-            raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
-        diagonal = np.diag(self.M)
-        if self.n > SMALL and not np.count_nonzero(self.M - np.diag(diagonal)):
-            # Bodies that are points or decoupled coordinates: M^-1 is the reciprocal diagonal.
-            if not (diagonal > 0).all():
-                raise InvalidProblem("M is not positive definite")
-            set_(self, "_inverse_diagonal", 1.0 / diagonal)
-        else:
-            try:
-                set_(self, "_cholesky", (np.linalg.cholesky(self.M), True))
-            except np.linalg.LinAlgError:
-                raise InvalidProblem("M is not positive definite") from None
-        self._check_normals()
-        with np.errstate(over="ignore", invalid="ignore"):
-            energy = float(self.v @ self.M @ self.v)
-        if not math.isfinite(energy):
-            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({energy})")
+        self._check_normals(self._factor_mass())
+        if not math.isfinite(self.T_minus):
+            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({self.T_minus})")
 
     @classmethod
     def from_arrays(
@@ -265,33 +265,62 @@ class ImpactProblem:
         ]
         return cls(M, Wn, v, contacts, Wt, dict(bodies or {}), gaps)
 
-    def _check_normals(self) -> None:
+    def _factor_mass(self) -> float:
+        """Check that M is symmetric positive definite and keep what `solve_mass` uses.
+
+        A diagonal M (points, decoupled coordinates) is inverted exactly by its reciprocal
+        diagonal; any other by its Cholesky factor. Returns the largest diagonal entry of M^-1.
+        """
+        diagonal = self.M.diagonal()
+        if np.count_nonzero(self.M) == np.count_nonzero(diagonal):
+            smallest = float(diagonal.min())
+            if not smallest > 0:
+                raise InvalidProblem("M is not positive definite")
+            if math.isinf(1.0 / smallest):
+                self._too_close_to_singular()
+            reciprocal = 1.0 / diagonal
+            reciprocal.flags.writeable = False
+            object.__setattr__(self, "_inverse_diagonal", reciprocal)
+            return float(reciprocal.max())
+        asymmetry = np.abs(self.M - self.M.T).max()
+        if asymmetry > 1e-12 * np.abs(self.M).max():
+            raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
+        try:
+            object.__setattr__(self, "_cholesky", (np.linalg.cholesky(self.M), True))
+        except np.linalg.LinAlgError:
+            raise InvalidProblem("M is not positive definite") from None
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            inverse = _cho_solve(self._cholesky, np.eye(self.n))
+        if not all_finite(inverse):
+            self._too_close_to_singular()
+        if self.n <= SMALL:
+            inverse.flags.writeable = False
+            object.__setattr__(self, "_inverse", inverse)
+        return float(inverse.diagonal().max())
+
+    def _too_close_to_singular(self) -> NoReturn:
+        diagonal = np.diag(self.M)
+        raise InvalidProblem(
+            f"M is too close to singular: its inverse overflows (smallest diagonal entry "
+            f"M[{int(np.argmin(diagonal))}, {int(np.argmin(diagonal))}] = {diagonal.min():.3g})"
+        )
+
+    def _check_normals(self, inverse_mass: float) -> None:
         """Refuse a contact that no motion can push along its normal (a singular configuration).
 
         Its normal Delassus entry is then rounding noise (for example a pendulum hanging
         straight down onto the floor), and every law's impulse would be meaningless.
+        ``inverse_mass`` is the largest diagonal entry of M^-1, within a factor n of its largest
+        eigenvalue: scale enough for a test at rounding level.
         """
-        W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
-        reciprocal = self.__dict__.get("_inverse_diagonal")
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            if reciprocal is not None:
-                inverse = reciprocal[:, None]
-            else:
-                inverse = _cho_solve(self._cholesky, np.eye(self.n))
-        if not np.isfinite(inverse).all():
-            diagonal = np.diag(self.M)
-            raise InvalidProblem(
-                f"M is too close to singular: its inverse overflows (smallest diagonal entry "
-                f"M[{int(np.argmin(diagonal))}, {int(np.argmin(diagonal))}] = {diagonal.min():.3g})"
-            )
+        scale = inverse_mass * float(np.einsum("ij,ij->j", self.W, self.W).max())
         if self.n <= SMALL:
-            inverse.flags.writeable = False
-            object.__setattr__(self, "_inverse", inverse)
-        # The largest diagonal entry of M^-1 is within a factor n of its largest eigenvalue:
-        # scale enough for a test at rounding level.
-        inverse_mass = float(inverse.max() if reciprocal is not None else np.diag(inverse).max())
-        scale = inverse_mass * float((W**2).sum(axis=0).max())
-        normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
+            # The Delassus matrix is cheap here and every law needs it: its diagonal serves.
+            normal = self.delassus.diagonal()
+        else:
+            normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
+        if normal.min() > 1e-12 * scale:
+            return
         for j in np.flatnonzero(normal <= 1e-12 * scale):
             raise InvalidProblem(
                 f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 Wn[:, {j}]"
@@ -318,10 +347,29 @@ class ImpactProblem:
         """Whether some contact has a tangential Jacobian and a positive mu."""
         return self.Wt is not None and any(c.mu > 0 for c in self.contacts)
 
-    @property
+    @cached_property
     def closed(self) -> np.ndarray:
         """Boolean mask of the contacts with zero gap, the ones an impact involves."""
-        return self.gaps <= 0.0
+        closed = self.gaps <= 0.0
+        closed.flags.writeable = False
+        return closed
+
+    @cached_property
+    def closed_count(self) -> int:
+        """Number of closed contacts."""
+        return int(np.count_nonzero(self.closed))
+
+    @cached_property
+    def separating(self) -> tuple[int, ...]:
+        """Closed contacts whose gap rate is positive before the impact (they separate)."""
+        scale = float(np.abs(self.un).max())
+        separating = self.closed & (self.un > SEPARATING * (scale or 1.0))
+        return tuple(int(j) for j in np.flatnonzero(separating))
+
+    @cached_property
+    def T_minus(self) -> float:
+        """Kinetic energy before the impact, ``v @ M @ v / 2`` (inf when it overflows)."""
+        return float(self.v @ self.M @ self.v) / 2.0
 
     def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
         """Return ``M^-1 @ rhs``: the cached inverse of a small M, else its Cholesky factor."""
@@ -357,7 +405,9 @@ class ImpactProblem:
     @cached_property
     def un(self) -> np.ndarray:
         """Pre-impact normal gap rates ``Wn.T @ v``."""
-        return self.Wn.T @ self.v
+        un = self.Wn.T @ self.v
+        un.flags.writeable = False
+        return un
 
     @cached_property
     def W(self) -> np.ndarray:

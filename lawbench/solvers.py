@@ -199,7 +199,10 @@ def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     """
     q = np.asarray(q, dtype=float)
     if q.ndim == 1 and np.ndim(G) == 2:
-        return _enumerate_one(np.asarray(G, dtype=float), q)
+        solved = _enumerate_one(np.asarray(G, dtype=float), q)
+        if solved is None:
+            return np.zeros_like(q), np.array(False)
+        return solved[0], np.array(True)
     batch, m = q.shape[:-1], q.shape[-1]
     qs = q.reshape(-1, m)
     Gs = np.broadcast_to(np.asarray(G, dtype=float), (*batch, m, m)).reshape(-1, m, m)
@@ -227,16 +230,52 @@ def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return z.reshape(*batch, m), found.reshape(batch)
 
 
-def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """`enumerate_lcp` for one problem: ``(z, w = G z + q)``, or None where no set is found.
+
+    One problem of a few contacts is dominated by the cost of calling numpy, so it is solved in
+    Python floats: two contacts by their closed form, more by the same enumeration.
+    """
+    solved = _two_contacts(G, q) if len(q) == 2 else _enumerate_sets(G, q)
+    return None if solved is None else (np.array(solved[0]), np.array(solved[1]))
+
+
+def _two_contacts(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float]] | None:
+    """The LCP of two contacts in closed form, as `enumerate_lcp` solves it.
+
+    The active sets {}, {0}, {1}, {0, 1} in that order, each set's equations solved by the
+    formulas of `_solve_blocks` and held to the same tests, so the answer is the same.
+    """
+    (a, b), (c, d) = G.tolist()
+    q0, q1 = q.tolist()
+    det = a * d - b * c
+    candidates = (
+        (0.0, 0.0),
+        (-q0 / a if a else math.inf, 0.0),
+        (0.0, -q1 / d if d else math.inf),
+        ((d * -q0 - b * -q1) / det, (a * -q1 - b * -q0) / det) if det else (math.inf, 0.0),
+    )
+    floor = -COMPLEMENTARITY * max(abs(q0), abs(q1), ROUNDING)
+    for z0, z1 in candidates:
+        if not (math.isfinite(z0) and math.isfinite(z1)):
+            continue
+        if min(z0, z1) < -COMPLEMENTARITY * max(abs(z0), abs(z1), ROUNDING):
+            continue
+        if min(a * z0 + b * z1 + q0, c * z0 + d * z1 + q1) >= floor:
+            z0, z1 = max(z0, 0.0), max(z1, 0.0)
+            return [z0, z1], [a * z0 + b * z1 + q0, c * z0 + d * z1 + q1]
+    return None
+
+
+def _enumerate_sets(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float]] | None:
     """`enumerate_lcp` for one problem, in Python floats: the same sets, formulas and tests.
 
-    One problem of a few contacts is dominated by the cost of calling numpy, so the blocks of
-    one and two rows are solved with the same closed forms in plain arithmetic (identical in
-    IEEE double), and only larger blocks go through LU.
+    Blocks of one and two rows are solved with the closed forms of `_solve_blocks` in plain
+    arithmetic (identical in IEEE double), and only larger blocks go through LU.
     """
     m = len(q)
     rows, rhs = G.tolist(), q.tolist()
-    velocity_scale = max(max(abs(x) for x in rhs), ROUNDING)
+    floor = -COMPLEMENTARITY * max(max(abs(x) for x in rhs), ROUNDING)
     for active in _active_sets(m):
         candidate = [0.0] * m
         if len(active) == 1:
@@ -259,13 +298,17 @@ def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray
         impulse_scale = max(max(abs(x) for x in candidate), ROUNDING)
         if min(candidate) < -COMPLEMENTARITY * impulse_scale:
             continue
-        slack = [
-            sum(g * x for g, x in zip(row, candidate, strict=True)) + b
-            for row, b in zip(rows, rhs, strict=True)
-        ]
-        if min(slack) >= -COMPLEMENTARITY * velocity_scale:
-            return np.maximum(np.array(candidate), 0.0), np.array(True)
-    return np.zeros(m), np.array(False)
+        if min(_affine(rows, candidate, rhs)) >= floor:
+            z = [max(x, 0.0) for x in candidate]
+            return z, _affine(rows, z, rhs)
+    return None
+
+
+def _affine(rows: list[list[float]], z: list[float], q: list[float]) -> list[float]:
+    """``G z + q`` in Python floats, G given by its rows."""
+    return [
+        sum(g * x for g, x in zip(row, z, strict=True)) + b for row, b in zip(rows, q, strict=True)
+    ]
 
 
 def solve_lcp(
@@ -295,9 +338,9 @@ def solve_lcp(
         method = "closed form" if len(q) == 1 else "decoupled (diagonal Delassus)"
         return LCPResult(z, G @ z + q, method)
     if len(q) <= ENUMERATION_MAX:
-        z, found = enumerate_lcp(G, q)
-        if found:
-            return LCPResult(z, G @ z + q, "LCP (active-set enumeration)")
+        solved = _enumerate_one(G, q)
+        if solved is not None:
+            return LCPResult(*solved, "LCP (active-set enumeration)")
     if method == "nnls":
         return _nnls_lcp(G, q)
     result = clarabel_qp(G, q, np.eye(len(q)), tol)
