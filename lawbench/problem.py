@@ -9,10 +9,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
-from typing import NoReturn
+from typing import Any, Generic, NoReturn, TypeVar, overload
 
 import numpy as np
 
@@ -25,6 +24,44 @@ SMALL = 64
 SPARSE_SHARE = 0.05
 # A closed contact separates when its gap rate exceeds this fraction of the largest rate.
 SEPARATING = 1e-12
+
+
+_T = TypeVar("_T")
+
+
+class cached_property(Generic[_T]):  # noqa: N801 (named as the functools one it replaces)
+    """A computed attribute, stored in the instance on first use.
+
+    `functools.cached_property` without the lock it takes on every first use before Python
+    3.12: a problem is immutable, so two threads that both compute a value get the same one.
+    """
+
+    def __init__(self, function: Callable[[Any], _T]) -> None:
+        self.function = function
+        self.name = function.__name__
+        self.__doc__ = function.__doc__
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, instance: None, owner: type | None = None) -> cached_property[_T]: ...
+
+    @overload
+    def __get__(self, instance: object, owner: type | None = None) -> _T: ...
+
+    def __get__(self, instance: object | None, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        value = self.function(instance)
+        instance.__dict__[self.name] = value
+        return value
+
+
+def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
+    """Return ``v @ M @ v / 2`` (inf, without a warning, when it overflows)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(v @ M @ v) / 2.0
 
 
 def all_finite(array: np.ndarray) -> bool:
@@ -107,6 +144,9 @@ class Contact:
         return self.e if override is None else override
 
 
+CONTACT_FIELDS = frozenset(f.name for f in dataclasses.fields(Contact))
+
+
 def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray:
     """``M^-1 rhs`` from M's lower Cholesky factor.
 
@@ -182,6 +222,8 @@ class ImpactProblem:
         if m < 1:
             raise InvalidProblem("contacts is empty: an impact needs at least one contact")
         for j, contact in enumerate(contacts):
+            if j and contact is contacts[j - 1]:
+                continue
             if not isinstance(contact, Contact):
                 raise InvalidProblem(f"contacts[{j}] is {type(contact).__name__}, not Contact")
             contact.validate(f"contacts[{j}]")
@@ -241,28 +283,33 @@ class ImpactProblem:
             For an unknown coefficient, a sequence of the wrong length, or any bad field.
         """
         m = np.shape(Wn)[1] if np.ndim(Wn) == 2 else 0
-        known = {f.name for f in dataclasses.fields(Contact)}
+        shared: dict[str, object] = {}
         per_contact: dict[str, list[object]] = {}
         for name, value in coefficients.items():
-            if name not in known:
-                raise InvalidProblem(
-                    f"unknown contact coefficient {name!r}; known: {', '.join(sorted(known))}"
-                )
-            if isinstance(value, str) or not isinstance(value, Sequence | np.ndarray):
-                per_contact[name] = [value] * m
-            elif len(value) != m:
+            if name not in CONTACT_FIELDS:
+                known = ", ".join(sorted(CONTACT_FIELDS))
+                raise InvalidProblem(f"unknown contact coefficient {name!r}; known: {known}")
+            one = isinstance(value, str) or not isinstance(value, Sequence | np.ndarray)
+            if not one and len(value) != m:
                 raise InvalidProblem(
                     f"{name} has {len(value)} values, expected 1 or {m} (one per contact)"
                 )
+            values = [value] * m if one else list(value)
+            for j, entry in enumerate(values):
+                if entry is not None and not isinstance(entry, int | float | np.number):
+                    raise InvalidProblem(f"contacts[{j}].{name} = {entry!r}: not a number")
+            if one:
+                shared[name] = value
             else:
-                per_contact[name] = list(value)
-        for name, values in per_contact.items():
-            for j, value in enumerate(values):
-                if value is not None and not isinstance(value, int | float | np.number):
-                    raise InvalidProblem(f"contacts[{j}].{name} = {value!r}: not a number")
-        contacts = [
-            Contact(**{name: values[j] for name, values in per_contact.items()}) for j in range(m)
-        ]
+                per_contact[name] = values
+        if per_contact:
+            contacts = [
+                Contact(**shared, **{name: values[j] for name, values in per_contact.items()})
+                for j in range(m)
+            ]
+        else:
+            # One set of coefficients: one (immutable) contact serves, validated once.
+            contacts = [Contact(**shared)] * m
         return cls(M, Wn, v, contacts, Wt, dict(bodies or {}), gaps)
 
     def _factor_mass(self) -> float:
@@ -362,6 +409,8 @@ class ImpactProblem:
     @cached_property
     def separating(self) -> tuple[int, ...]:
         """Closed contacts whose gap rate is positive before the impact (they separate)."""
+        if self.un.max() <= 0.0:
+            return ()
         scale = float(np.abs(self.un).max())
         separating = self.closed & (self.un > SEPARATING * (scale or 1.0))
         return tuple(int(j) for j in np.flatnonzero(separating))
@@ -369,7 +418,7 @@ class ImpactProblem:
     @cached_property
     def T_minus(self) -> float:
         """Kinetic energy before the impact, ``v @ M @ v / 2`` (inf when it overflows)."""
-        return float(self.v @ self.M @ self.v) / 2.0
+        return kinetic_energy(self.M, self.v)
 
     def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
         """Return ``M^-1 @ rhs``: the cached inverse of a small M, else its Cholesky factor."""
@@ -440,17 +489,19 @@ class ImpactProblem:
 
     def restitution(self, kind: str) -> np.ndarray:
         """Per-contact restitution coefficients of ``kind`` ('newton', 'poisson', 'energy')."""
-        if kind not in RESTITUTION_KINDS:
-            raise ValueError(f"unknown restitution kind {kind!r}")
-        return self._restitutions[kind]
+        coefficients = self._restitutions.get(kind)
+        if coefficients is None:
+            if kind not in RESTITUTION_KINDS:
+                raise ValueError(f"unknown restitution kind {kind!r}")
+            coefficients = np.array([c.restitution(kind) for c in self.contacts])
+            coefficients.flags.writeable = False
+            self._restitutions[kind] = coefficients
+        return coefficients
 
     @cached_property
     def _restitutions(self) -> dict[str, np.ndarray]:
-        coefficients = {}
-        for kind in RESTITUTION_KINDS:
-            coefficients[kind] = np.array([c.restitution(kind) for c in self.contacts])
-            coefficients[kind].flags.writeable = False
-        return coefficients
+        """The coefficients of each kind asked for so far."""
+        return {}
 
     def select_contacts(self, mask: np.ndarray) -> ImpactProblem:
         """Return the problem restricted to the contacts where ``mask`` is true."""
