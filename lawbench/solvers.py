@@ -156,26 +156,69 @@ def _active_sets(m: int) -> tuple[np.ndarray, ...]:
 
 
 def _solve_blocks(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Solve the stacked systems ``A[k] x[k] = b[k]``.
+    """Solve the stacked systems ``A[k] x[k] = b[k]`` of three rows or more.
 
-    Blocks of one and two rows by their closed forms (a singular one gives non-finite numbers,
-    which the caller rejects); larger ones by LU, or their least-norm solution when singular.
+    By LU, or their least-norm solution when one is singular (the caller rejects the answer).
     """
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        warnings.simplefilter("ignore", RuntimeWarning)
-        if A.shape[-1] == 1:
-            return b / A[..., 0]
-        if A.shape[-1] == 2:
-            a, c, d = A[..., 0, 0], A[..., 0, 1], A[..., 1, 1]
-            det = a * d - c * A[..., 1, 0]
-            return (
-                np.stack([(d * b[..., 0] - c * b[..., 1]), (a * b[..., 1] - c * b[..., 0])], -1)
-                / det[..., None]
-            )
-        try:
-            return np.linalg.solve(A, b[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            return (np.linalg.pinv(A) @ b[..., None])[..., 0]
+    try:
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return (np.linalg.pinv(A) @ b[..., None])[..., 0]
+
+
+def _solve_set(
+    G: list[list[np.ndarray]], q: list[np.ndarray], active: tuple[int, ...]
+) -> list[np.ndarray]:
+    """The impulses of the ``active`` contacts that zero their slack, for a stack of problems.
+
+    ``G`` and ``q`` are given entry by entry (arrays over the stack). Blocks of one and two rows
+    by their closed forms (a singular one gives non-finite numbers, which the caller rejects);
+    larger ones by `_solve_blocks`.
+    """
+    if not active:
+        return []
+    if len(active) == 1:
+        (i,) = active
+        return [-q[i] / G[i][i]]
+    if len(active) == 2:
+        i, j = active
+        a, c, d = G[i][i], G[i][j], G[j][j]
+        det = a * d - c * G[j][i]
+        return [(d * -q[i] - c * -q[j]) / det, (a * -q[j] - c * -q[i]) / det]
+    block = np.stack([np.stack([G[i][j] for j in active], -1) for i in active], -2)
+    solved = _solve_blocks(block, np.stack([-q[i] for i in active], -1))
+    return [solved[:, k] for k in range(len(active))]
+
+
+def _enumerate_batch(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`enumerate_lcp` for a stack of problems, G (B, m, m) and q (B, m).
+
+    Each entry of G, q and z is one array over the stack, so that every step is an elementwise
+    operation on B numbers: numpy's reductions over a handful of contacts are slow. The tests
+    are those of the one-problem path (an inactive contact's zero impulse passes them).
+    """
+    batch, m = q.shape
+    g = [[G[:, i, j] for j in range(m)] for i in range(m)]
+    rhs = [q[:, i] for i in range(m)]
+    z = [np.zeros(batch) for _ in range(m)]
+    found = np.zeros(batch, dtype=bool)
+    floor = -COMPLEMENTARITY * functools.reduce(np.maximum, map(np.abs, rhs), ROUNDING)
+    for active in _active_sets(m):
+        if found.all():
+            break
+        with np.errstate(all="ignore"):
+            solved = _solve_set(g, rhs, tuple(active.tolist()))
+            scale = functools.reduce(np.maximum, map(np.abs, solved), ROUNDING)
+            good = ~found
+            for x in solved:
+                good &= np.isfinite(x) & (x >= -COMPLEMENTARITY * scale)
+            for i in range(m):
+                terms = [g[i][j] * x for j, x in zip(active.tolist(), solved, strict=True)]
+                good &= sum(terms, start=0.0) + rhs[i] >= floor
+        for j, x in zip(active.tolist(), solved, strict=True):
+            z[j] = np.where(good, np.maximum(x, 0.0), z[j])
+        found |= good
+    return np.stack(z, axis=-1), found
 
 
 def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -204,29 +247,8 @@ def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
             return np.zeros_like(q), np.array(False)
         return solved[0], np.array(True)
     batch, m = q.shape[:-1], q.shape[-1]
-    qs = q.reshape(-1, m)
-    Gs = np.broadcast_to(np.asarray(G, dtype=float), (*batch, m, m)).reshape(-1, m, m)
-    z = np.zeros_like(qs)
-    found = np.zeros(len(qs), dtype=bool)
-    velocity_scale = np.maximum(np.abs(qs).max(axis=1, initial=0.0), ROUNDING)
-    for active in _active_sets(m):
-        if found.all():
-            break
-        candidate = np.zeros_like(qs)
-        if active.size:
-            block = Gs[:, active[:, None], active]
-            candidate[:, active] = _solve_blocks(block, -qs[:, active])
-        with np.errstate(all="ignore"):
-            slack = np.einsum("kij,kj->ki", Gs, candidate) + qs
-            impulse_scale = np.maximum(np.abs(candidate).max(axis=1), ROUNDING)
-            good = (
-                ~found
-                & np.isfinite(candidate).all(axis=1)
-                & (candidate.min(axis=1) >= -COMPLEMENTARITY * impulse_scale)
-                & (slack.min(axis=1) >= -COMPLEMENTARITY * velocity_scale)
-            )
-        z[good] = np.maximum(candidate[good], 0.0)
-        found |= good
+    G = np.broadcast_to(np.asarray(G, dtype=float), (*batch, m, m)).reshape(-1, m, m)
+    z, found = _enumerate_batch(G, q.reshape(-1, m))
     return z.reshape(*batch, m), found.reshape(batch)
 
 
@@ -244,7 +266,7 @@ def _two_contacts(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float
     """The LCP of two contacts in closed form, as `enumerate_lcp` solves it.
 
     The active sets {}, {0}, {1}, {0, 1} in that order, each set's equations solved by the
-    formulas of `_solve_blocks` and held to the same tests, so the answer is the same.
+    formulas of `_solve_set` and held to the same tests, so the answer is the same.
     """
     (a, b), (c, d) = G.tolist()
     q0, q1 = q.tolist()
@@ -270,7 +292,7 @@ def _two_contacts(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float
 def _enumerate_sets(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float]] | None:
     """`enumerate_lcp` for one problem, in Python floats: the same sets, formulas and tests.
 
-    Blocks of one and two rows are solved with the closed forms of `_solve_blocks` in plain
+    Blocks of one and two rows are solved with the closed forms of `_solve_set` in plain
     arithmetic (identical in IEEE double), and only larger blocks go through LU.
     """
     m = len(q)
@@ -290,7 +312,8 @@ def _enumerate_sets(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[flo
             candidate[i] = (d * -rhs[i] - c * -rhs[j]) / det
             candidate[j] = (a * -rhs[j] - c * -rhs[i]) / det
         elif len(active) > 2:
-            solved = _solve_blocks(G[np.ix_(active, active)][None], -q[active][None])[0]
+            with np.errstate(all="ignore"):
+                solved = _solve_blocks(G[np.ix_(active, active)][None], -q[active][None])[0]
             for i, x in zip(active.tolist(), solved.tolist(), strict=True):
                 candidate[i] = x
         if not all(math.isfinite(x) for x in candidate):
