@@ -289,7 +289,9 @@ class ImpactProblem:
             if name not in CONTACT_FIELDS:
                 known = ", ".join(sorted(CONTACT_FIELDS))
                 raise InvalidProblem(f"unknown contact coefficient {name!r}; known: {known}")
-            one = isinstance(value, str) or not isinstance(value, Sequence | np.ndarray)
+            one = isinstance(value, int | float | str) or not isinstance(
+                value, Sequence | np.ndarray
+            )
             if not one and len(value) != m:
                 raise InvalidProblem(
                     f"{name} has {len(value)} values, expected 1 or {m} (one per contact)"
@@ -328,7 +330,8 @@ class ImpactProblem:
             reciprocal = 1.0 / diagonal
             reciprocal.flags.writeable = False
             object.__setattr__(self, "_inverse_diagonal", reciprocal)
-            return float(reciprocal.max())
+            # Rounded division is monotone: the largest reciprocal is that of the smallest mass.
+            return 1.0 / smallest
         asymmetry = np.abs(self.M - self.M.T).max()
         if asymmetry > 1e-12 * np.abs(self.M).max():
             raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
@@ -360,14 +363,16 @@ class ImpactProblem:
         ``inverse_mass`` is the largest diagonal entry of M^-1, within a factor n of its largest
         eigenvalue: scale enough for a test at rounding level.
         """
-        scale = inverse_mass * float(np.einsum("ij,ij->j", self.W, self.W).max())
         if self.n <= SMALL:
             # The Delassus matrix is cheap here and every law needs it: its diagonal serves.
             normal = self.delassus.diagonal()
         else:
             normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
-        if normal.min() > 1e-12 * scale:
+        # The squared Frobenius norm of W bounds its largest squared column: one product
+        # settles the usual case.
+        if normal.min() > 1e-12 * inverse_mass * float(np.vdot(self.W, self.W)):
             return
+        scale = inverse_mass * float(np.einsum("ij,ij->j", self.W, self.W).max())
         for j in np.flatnonzero(normal <= 1e-12 * scale):
             raise InvalidProblem(
                 f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 Wn[:, {j}]"
@@ -404,7 +409,7 @@ class ImpactProblem:
     @cached_property
     def closed_count(self) -> int:
         """Number of closed contacts."""
-        return int(np.count_nonzero(self.closed))
+        return self.m - int(np.count_nonzero(self.gaps))
 
     @cached_property
     def separating(self) -> tuple[int, ...]:
