@@ -211,9 +211,10 @@ class ProblemBatch:
         """Normal Delassus matrices ``Wn.T M^-1 Wn``, (B, m, m)."""
         reciprocal = self.__dict__.get("_inverse_diagonal")
         if reciprocal is not None:
-            # Symmetric by construction; one pass over the entries instead of a stack of products.
-            return np.einsum("kij,ki,kil->kjl", self.Wn, reciprocal, self.Wn)
-        G = np.swapaxes(self.Wn, 1, 2) @ self.solve_mass(self.Wn)
+            # One pass over the entries instead of a stack of small matrix products.
+            G = np.einsum("kij,ki,kil->kjl", self.Wn, reciprocal, self.Wn)
+        else:
+            G = np.swapaxes(self.Wn, 1, 2) @ self.solve_mass(self.Wn)
         return (G + np.swapaxes(G, 1, 2)) / 2
 
     @cached_property
