@@ -58,10 +58,10 @@ class cached_property(Generic[_T]):  # noqa: N801 (named as the functools one it
         return value
 
 
+@np.errstate(over="ignore", invalid="ignore")
 def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
     """Return ``v @ M @ v / 2`` (inf, without a warning, when it overflows)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        return float(v @ M @ v) / 2.0
+    return float(v @ M @ v) / 2.0
 
 
 def all_finite(array: np.ndarray) -> bool:
