@@ -23,11 +23,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from lawbench.errors import InvalidProblem
-from lawbench.problem import Contact, ImpactProblem
+from lawbench.problem import Contact, ImpactProblem, all_finite
 
 if TYPE_CHECKING:
     import pandas as pd
 
+_OVERFLOW = "M is too close to singular (its inverse overflows)"
 # Contact fields a batch carries per problem and contact, with their allowed ranges.
 COEFFICIENTS = {"e": (0.0, 1.0), "e_newton": (0.0, 1.0), "e_poisson": (0.0, 1.0)}
 
@@ -38,13 +39,14 @@ def _stack(name: str, value: object, shape: tuple[int, ...], batch: int | None) 
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
+    # Before broadcasting: one array that serves every problem is checked once.
+    finite = all_finite(array)
     if array.shape == shape and batch is not None:
         array = np.broadcast_to(array, (batch, *shape))
     if array.ndim != len(shape) + 1 or array.shape[1:] != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected (B, {shape}) or {shape}")
-    bad = np.argwhere(~np.isfinite(array))
-    if bad.size:
-        index = tuple(int(i) for i in bad[0])
+    if not finite:
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
         raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
     return array
 
@@ -98,9 +100,9 @@ class ProblemBatch:
                 )
             array = np.broadcast_to(np.asarray(value, dtype=float), (batch, m))
             low, high = COEFFICIENTS[name]
-            bad = np.argwhere(~((array >= low) & (array <= high)))
-            if bad.size:
-                k, j = (int(i) for i in bad[0])
+            # NaN fails both comparisons.
+            if not (array.min() >= low and array.max() <= high):
+                k, j = (int(i) for i in np.argwhere(~((array >= low) & (array <= high)))[0])
                 raise InvalidProblem(
                     f"problem {k}: contacts[{j}].{name} = {array[k, j]}: must be in "
                     f"[{low:g}, {high:g}]"
@@ -108,35 +110,50 @@ class ProblemBatch:
             coefficients[name] = array
         coefficients.setdefault("e", np.ones((batch, m)))
         set_(self, "coefficients", coefficients)
-        asymmetry = np.abs(self.M - np.swapaxes(self.M, 1, 2)).max(axis=(1, 2))
-        scale = np.abs(self.M).max(axis=(1, 2))
-        for k in np.flatnonzero(asymmetry > 1e-12 * scale)[:1]:
-            raise InvalidProblem(f"problem {k}: M is not symmetric ({asymmetry[k]:.3g})")
-        # Diagonal mass matrices (particles, chains) are inverted entry by entry, exactly.
-        masses = np.einsum("kii->ki", self.M)
-        diagonal_mass = not (self.M - np.einsum("ki,ij->kij", masses, np.eye(n))).any()
-        smallest = masses.min(axis=1) if diagonal_mass else np.linalg.eigvalsh(self.M)[:, 0]
-        for k in np.flatnonzero(~(smallest > 0))[:1]:
-            raise InvalidProblem(f"problem {k}: M is not positive definite")
-        with np.errstate(all="ignore"):
-            inverse = (
-                np.einsum("ki,ij->kij", 1.0 / masses, np.eye(n))
-                if diagonal_mass
-                else np.linalg.inv(self.M)
-            )
-            set_(self, "_inverse", inverse)
-        for k in np.flatnonzero(~np.isfinite(self._inverse).all(axis=(1, 2)))[:1]:
-            raise InvalidProblem(f"problem {k}: M is too close to singular (its inverse overflows)")
+        smallest = self._factor_mass()
         # The criterion of `ImpactProblem`: a normal Delassus entry at rounding level against
         # the largest inverse mass times the largest squared column of Wn.
         diagonal = np.einsum("kjj->kj", self.delassus)
         inverse_mass = 1.0 / smallest
-        floor = 1e-12 * inverse_mass * (self.Wn**2).sum(axis=1).max(axis=1)
+        floor = 1e-12 * inverse_mass * np.einsum("kij,kij->kj", self.Wn, self.Wn).max(axis=1)
         for k, j in np.argwhere(diagonal <= floor[:, None])[:1]:
             raise InvalidProblem(
                 f"problem {k}: contacts[{j}]: no motion moves it along its normal "
                 f"(Wn[:, {j}] M^-1 Wn[:, {j}] = {diagonal[k, j]:.3g})"
             )
+
+    def _factor_mass(self) -> np.ndarray:
+        """Check every M and keep its inverse; return the smallest eigenvalue of each.
+
+        Diagonal mass matrices (particles, chains) are inverted entry by entry, exactly.
+        """
+        masses = np.einsum("kii->ki", self.M)
+        if np.count_nonzero(self.M) == np.count_nonzero(masses):
+            smallest = masses.min(axis=1)
+            self._refuse("M is not positive definite", ~(smallest > 0))
+            with np.errstate(all="ignore"):
+                reciprocal = 1.0 / masses
+            object.__setattr__(self, "_inverse_diagonal", reciprocal)
+            if not all_finite(reciprocal):
+                self._refuse(_OVERFLOW, ~np.isfinite(reciprocal).all(axis=1))
+            return smallest
+        asymmetry = np.abs(self.M - np.swapaxes(self.M, 1, 2)).max(axis=(1, 2))
+        asymmetric = asymmetry > 1e-12 * np.abs(self.M).max(axis=(1, 2))
+        for k in np.flatnonzero(asymmetric)[:1]:
+            raise InvalidProblem(f"problem {k}: M is not symmetric ({asymmetry[k]:.3g})")
+        smallest = np.linalg.eigvalsh(self.M)[:, 0]
+        self._refuse("M is not positive definite", ~(smallest > 0))
+        with np.errstate(all="ignore"):
+            inverse = np.linalg.inv(self.M)
+        object.__setattr__(self, "_inverse", inverse)
+        self._refuse(_OVERFLOW, ~np.isfinite(inverse).all(axis=(1, 2)))
+        return smallest
+
+    @staticmethod
+    def _refuse(reason: str, bad: np.ndarray) -> None:
+        """Raise `InvalidProblem` for the first problem where ``bad`` holds."""
+        for k in np.flatnonzero(bad)[:1]:
+            raise InvalidProblem(f"problem {k}: {reason}")
 
     @classmethod
     def from_problems(cls, problems: Sequence[ImpactProblem]) -> ProblemBatch:
@@ -182,6 +199,9 @@ class ProblemBatch:
 
     def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
         """``M^-1 @ rhs`` for every problem (``rhs`` of shape (B, n) or (B, n, k))."""
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None:
+            return reciprocal * rhs if rhs.ndim == 2 else reciprocal[:, :, None] * rhs
         if rhs.ndim == 2:
             return np.einsum("kij,kj->ki", self._inverse, rhs)
         return self._inverse @ rhs
@@ -189,7 +209,12 @@ class ProblemBatch:
     @cached_property
     def delassus(self) -> np.ndarray:
         """Normal Delassus matrices ``Wn.T M^-1 Wn``, (B, m, m)."""
-        G = np.swapaxes(self.Wn, 1, 2) @ self.solve_mass(self.Wn)
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None:
+            # One pass over the entries instead of a stack of small matrix products.
+            G = np.einsum("kij,ki,kil->kjl", self.Wn, reciprocal, self.Wn)
+        else:
+            G = np.swapaxes(self.Wn, 1, 2) @ self.solve_mass(self.Wn)
         return (G + np.swapaxes(G, 1, 2)) / 2
 
     @cached_property
@@ -203,6 +228,8 @@ class ProblemBatch:
 
     def kinetic_energy(self, v: np.ndarray) -> np.ndarray:
         """``v @ M @ v / 2`` for every problem."""
+        if "_inverse_diagonal" in self.__dict__:
+            return 0.5 * np.einsum("kn,kn,kn->k", v, np.einsum("kii->ki", self.M), v)
         return 0.5 * np.einsum("kn,knl,kl->k", v, self.M, v)
 
     def problem(self, k: int) -> ImpactProblem:

@@ -1,21 +1,21 @@
 """What one solve may spend: steps, events and wall-clock seconds, one mechanism for every law.
 
-`lawbench.law.Law.resolve` opens a `Budget` from the law's options for the time of the solve:
-``max_seconds`` (every law has it), ``max_steps`` (a law that steps: integrator steps,
-fixed-point iterations, binary impacts) and ``max_events`` (a law that restarts at events),
-each when the law declares it. The law's loops spend from `current()` (the event integrator
-of `lawbench.integrator` does it for the integrating laws; an iterative solver calls `step`
-once per iteration), and a budget that runs out raises `BudgetExceeded` naming the option,
-its amount and the seconds spent, which is what a budget cell of a table shows.
+`lawbench.law.Law.resolve` opens a `Budget` (a context manager) from the law's options for the
+time of the solve: ``max_seconds`` (every law has it), ``max_steps`` (a law that steps:
+integrator steps, fixed-point iterations, binary impacts) and ``max_events`` (a law that
+restarts at events), each when the law declares it. The law's loops spend from `current()`
+(the event integrator of `lawbench.integrator` does it for the integrating laws; an iterative
+solver calls `step` once per iteration), and a budget that runs out raises `BudgetExceeded`
+naming the option, its amount and the seconds spent, which is what a budget cell of a table
+shows.
 """
 
 from __future__ import annotations
 
-import contextlib
 import contextvars
 import math
 import time
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 from lawbench.errors import BudgetExceeded
@@ -108,18 +108,16 @@ class Budget:
         # deterministic, and a table groups its failed cells by message.
         raise BudgetExceeded(f"{self.law}: {what}, {option})", option, amount, self.spent_s)
 
+    def __enter__(self) -> Budget:
+        """Open the budget: `current` gives it inside the block (blocks nest)."""
+        self._token = _OPEN.set(self)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        _OPEN.reset(self._token)
+
 
 _OPEN: contextvars.ContextVar[Budget | None] = contextvars.ContextVar("budget", default=None)
-
-
-@contextlib.contextmanager
-def opened(budget: Budget) -> Iterator[Budget]:
-    """Make ``budget`` the `current` one inside the block (blocks nest)."""
-    token = _OPEN.set(budget)
-    try:
-        yield budget
-    finally:
-        _OPEN.reset(token)
 
 
 def current() -> Budget:

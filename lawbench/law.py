@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import time
 from abc import ABC, abstractmethod
 from typing import Any, ClassVar
@@ -23,7 +24,7 @@ from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.mechanics import separating_contacts
 from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
+from lawbench.problem import ImpactProblem, all_finite
 from lawbench.registry import Registry
 from lawbench.spec import Spec
 from lawbench.tags import Tags
@@ -124,12 +125,12 @@ class Law(ABC):
                 f"{self.name}: closed contacts {separating} separate before the impact, and the "
                 "law states no rule for them"
             )
-        closed = problem.closed
         start = time.perf_counter()
-        with budget.opened(budget.Budget.of(self.name, values)):
-            if closed.all() or self.follows_gaps:
+        with budget.Budget.of(self.name, values):
+            if problem.closed_count == problem.m or self.follows_gaps:
                 outcome = self._resolve(problem, values)
-            elif closed.any():
+            elif problem.closed_count:
+                closed = problem.closed
                 outcome = _embed(
                     self._resolve(problem.select_contacts(closed), values), closed, problem
                 )
@@ -139,9 +140,7 @@ class Law(ABC):
         wall_time = time.perf_counter() - start
         if problem.Wt is not None and outcome.Pt.size == 0:
             outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
-        for field in ("v_plus", "Pn", "Pt", "T_plus"):
-            if not np.all(np.isfinite(getattr(outcome, field))):
-                raise SolverFailure(f"{self.name}: non-finite {field} {getattr(outcome, field)}")
+        _refuse_non_finite(self.name, outcome)
         outcome.diagnostics["options"] = values
         if separating:
             outcome.diagnostics["separating_contacts"] = separating
@@ -201,6 +200,17 @@ class Law(ABC):
         A law with a vectorized path overrides this; it must give the answer of `_resolve`.
         """
         return None
+
+
+def _refuse_non_finite(name: str, outcome: Outcome) -> None:
+    """Raise `SolverFailure` naming the first field of ``outcome`` with a non-finite number."""
+    # One finite sum proves every number finite; only otherwise is each field looked at.
+    total = outcome.v_plus.sum() + outcome.Pn.sum() + outcome.T_plus
+    if math.isfinite(total + outcome.Pt.sum() if outcome.Pt.size else total):
+        return
+    for field in ("v_plus", "Pn", "Pt", "T_plus"):
+        if not all_finite(np.asarray(getattr(outcome, field))):
+            raise SolverFailure(f"{name}: non-finite {field} {getattr(outcome, field)}")
 
 
 def _embed(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outcome:

@@ -6,16 +6,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lawbench.problem import SMALL, SPARSE_SHARE, ImpactProblem
+from lawbench.problem import SMALL, SPARSE_SHARE, ImpactProblem, kinetic_energy
 
 if TYPE_CHECKING:
     import scipy.sparse
-
-
-def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
-    """Return ``v @ M @ v / 2`` (inf, without a warning, when it overflows)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        return float(v @ M @ v) / 2.0
 
 
 def generalized_impulse(
@@ -40,20 +34,14 @@ def gap_rates(problem: ImpactProblem, v: np.ndarray) -> np.ndarray:
     return problem.Wn.T @ v
 
 
-# A closed contact separates when its gap rate exceeds this fraction of the largest rate.
-SEPARATING = 1e-12
-
-
 def separating_contacts(problem: ImpactProblem) -> list[int]:
     """Closed contacts whose gap rate is positive before the impact (they separate)."""
-    scale = float(np.abs(problem.un).max()) if problem.m else 0.0
-    separating = problem.closed & (problem.un > SEPARATING * (scale or 1.0))
-    return [int(j) for j in np.flatnonzero(separating)]
+    return list(problem.separating)
 
 
 def is_diagonal(G: np.ndarray) -> bool:
     """Whether the Delassus matrix decouples the contacts (no off-diagonal term)."""
-    return not np.any(G - np.diag(np.diag(G)))
+    return np.count_nonzero(G) == np.count_nonzero(G.diagonal())
 
 
 def kinetic_angles(problem: ImpactProblem) -> np.ndarray:

@@ -121,7 +121,7 @@ class Outcome:
             v_plus=np.asarray(v_plus, dtype=float),
             Pn=np.asarray(Pn, dtype=float),
             Pt=np.zeros(0) if Pt is None else np.asarray(Pt, dtype=float),
-            T_minus=kinetic_energy(problem.M, problem.v),
+            T_minus=problem.T_minus,
             T_plus=kinetic_energy(problem.M, v_plus),
             status=status,
             diagnostics=dict(diagnostics or {}),

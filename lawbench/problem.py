@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
+from typing import Any, Generic, NoReturn, TypeVar, overload
 
 import numpy as np
 
@@ -22,6 +22,55 @@ RESTITUTION_KINDS = ("newton", "poisson", "energy")
 SMALL = 64
 # A matrix with at most this share of non-zero entries is multiplied as a sparse one.
 SPARSE_SHARE = 0.05
+# A closed contact separates when its gap rate exceeds this fraction of the largest rate.
+SEPARATING = 1e-12
+
+
+_T = TypeVar("_T")
+
+
+class cached_property(Generic[_T]):  # noqa: N801 (named as the functools one it replaces)
+    """A computed attribute, stored in the instance on first use.
+
+    `functools.cached_property` without the lock it takes on every first use before Python
+    3.12: a problem is immutable, so two threads that both compute a value get the same one.
+    """
+
+    def __init__(self, function: Callable[[Any], _T]) -> None:
+        self.function = function
+        self.name = function.__name__
+        self.__doc__ = function.__doc__
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, instance: None, owner: type | None = None) -> cached_property[_T]: ...
+
+    @overload
+    def __get__(self, instance: object, owner: type | None = None) -> _T: ...
+
+    def __get__(self, instance: object | None, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        value = self.function(instance)
+        instance.__dict__[self.name] = value
+        return value
+
+
+@np.errstate(over="ignore", invalid="ignore")
+def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
+    """Return ``v @ M @ v / 2`` (inf, without a warning, when it overflows)."""
+    return float(v @ M @ v) / 2.0
+
+
+def all_finite(array: np.ndarray) -> bool:
+    """Whether every entry of ``array`` is finite.
+
+    An infinite or NaN entry makes the sum non-finite, so a finite sum settles it in one
+    reduction; only a non-finite sum (which overflow can also give) is looked at entry by entry.
+    """
+    return math.isfinite(array.sum()) or bool(np.isfinite(array).all())
 
 
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
@@ -95,6 +144,9 @@ class Contact:
         return self.e if override is None else override
 
 
+CONTACT_FIELDS = frozenset(f.name for f in dataclasses.fields(Contact))
+
+
 def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray:
     """``M^-1 rhs`` from M's lower Cholesky factor.
 
@@ -116,7 +168,7 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
     if array.shape != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
-    if not np.isfinite(array).all():
+    if not all_finite(array):
         index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
         raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
     array.flags.writeable = False
@@ -170,6 +222,8 @@ class ImpactProblem:
         if m < 1:
             raise InvalidProblem("contacts is empty: an impact needs at least one contact")
         for j, contact in enumerate(contacts):
+            if j and contact is contacts[j - 1]:
+                continue
             if not isinstance(contact, Contact):
                 raise InvalidProblem(f"contacts[{j}] is {type(contact).__name__}, not Contact")
             contact.validate(f"contacts[{j}]")
@@ -183,35 +237,23 @@ class ImpactProblem:
             if d not in (1, 2):
                 raise InvalidProblem(f"Wt has shape {np.shape(self.Wt)}, expected ({n}, {m}*d)")
             set_(self, "Wt", _matrix("Wt", self.Wt, (n, m * d)))
-        gaps = np.zeros(m) if self.gaps is None else self.gaps
-        set_(self, "gaps", _matrix("gaps", gaps, (m,)))
-        if (self.gaps < 0).any():
-            j = int(np.argmax(self.gaps < 0))
-            raise InvalidProblem(f"gaps[{j}] = {self.gaps[j]:g}: must be >= 0")
+        if self.gaps is None:
+            gaps = np.zeros(m)
+            gaps.flags.writeable = False
+        else:
+            gaps = _matrix("gaps", self.gaps, (m,))
+            if (gaps < 0).any():
+                j = int(np.argmax(gaps < 0))
+                raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
+        set_(self, "gaps", gaps)
         bodies = {str(k): tuple(int(i) for i in idx) for k, idx in dict(self.bodies).items()}
         for name, idx in bodies.items():
             if any(i < 0 or i >= n for i in idx):
                 raise InvalidProblem(f"bodies[{name!r}] = {idx}: indices must lie in [0, {n})")
         set_(self, "bodies", bodies)
-        asymmetry = np.abs(self.M - self.M.T).max()
-        if asymmetry > 1e-12 * np.abs(self.M).max():
-            raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
-        diagonal = np.diag(self.M)
-        if self.n > SMALL and not np.count_nonzero(self.M - np.diag(diagonal)):
-            # Bodies that are points or decoupled coordinates: M^-1 is the reciprocal diagonal.
-            if not (diagonal > 0).all():
-                raise InvalidProblem("M is not positive definite")
-            set_(self, "_inverse_diagonal", 1.0 / diagonal)
-        else:
-            try:
-                set_(self, "_cholesky", (np.linalg.cholesky(self.M), True))
-            except np.linalg.LinAlgError:
-                raise InvalidProblem("M is not positive definite") from None
-        self._check_normals()
-        with np.errstate(over="ignore", invalid="ignore"):
-            energy = float(self.v @ self.M @ self.v)
-        if not math.isfinite(energy):
-            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({energy})")
+        self._check_normals(self._factor_mass())
+        if not math.isfinite(self.T_minus):
+            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({self.T_minus})")
 
     @classmethod
     def from_arrays(
@@ -241,57 +283,96 @@ class ImpactProblem:
             For an unknown coefficient, a sequence of the wrong length, or any bad field.
         """
         m = np.shape(Wn)[1] if np.ndim(Wn) == 2 else 0
-        known = {f.name for f in dataclasses.fields(Contact)}
+        shared: dict[str, object] = {}
         per_contact: dict[str, list[object]] = {}
         for name, value in coefficients.items():
-            if name not in known:
-                raise InvalidProblem(
-                    f"unknown contact coefficient {name!r}; known: {', '.join(sorted(known))}"
-                )
-            if isinstance(value, str) or not isinstance(value, Sequence | np.ndarray):
-                per_contact[name] = [value] * m
-            elif len(value) != m:
+            if name not in CONTACT_FIELDS:
+                known = ", ".join(sorted(CONTACT_FIELDS))
+                raise InvalidProblem(f"unknown contact coefficient {name!r}; known: {known}")
+            one = isinstance(value, int | float | str) or not isinstance(
+                value, Sequence | np.ndarray
+            )
+            if not one and len(value) != m:
                 raise InvalidProblem(
                     f"{name} has {len(value)} values, expected 1 or {m} (one per contact)"
                 )
+            values = [value] * m if one else list(value)
+            for j, entry in enumerate(values):
+                if entry is not None and not isinstance(entry, int | float | np.number):
+                    raise InvalidProblem(f"contacts[{j}].{name} = {entry!r}: not a number")
+            if one:
+                shared[name] = value
             else:
-                per_contact[name] = list(value)
-        for name, values in per_contact.items():
-            for j, value in enumerate(values):
-                if value is not None and not isinstance(value, int | float | np.number):
-                    raise InvalidProblem(f"contacts[{j}].{name} = {value!r}: not a number")
-        contacts = [
-            Contact(**{name: values[j] for name, values in per_contact.items()}) for j in range(m)
-        ]
+                per_contact[name] = values
+        if per_contact:
+            contacts = [
+                Contact(**shared, **{name: values[j] for name, values in per_contact.items()})
+                for j in range(m)
+            ]
+        else:
+            # One set of coefficients: one (immutable) contact serves, validated once.
+            contacts = [Contact(**shared)] * m
         return cls(M, Wn, v, contacts, Wt, dict(bodies or {}), gaps)
 
-    def _check_normals(self) -> None:
+    def _factor_mass(self) -> float:
+        """Check that M is symmetric positive definite and keep what `solve_mass` uses.
+
+        A diagonal M (points, decoupled coordinates) is inverted exactly by its reciprocal
+        diagonal; any other by its Cholesky factor. Returns the largest diagonal entry of M^-1.
+        """
+        diagonal = self.M.diagonal()
+        if np.count_nonzero(self.M) == np.count_nonzero(diagonal):
+            smallest = float(diagonal.min())
+            if not smallest > 0:
+                raise InvalidProblem("M is not positive definite")
+            if math.isinf(1.0 / smallest):
+                self._too_close_to_singular()
+            reciprocal = 1.0 / diagonal
+            reciprocal.flags.writeable = False
+            object.__setattr__(self, "_inverse_diagonal", reciprocal)
+            # Rounded division is monotone: the largest reciprocal is that of the smallest mass.
+            return 1.0 / smallest
+        asymmetry = np.abs(self.M - self.M.T).max()
+        if asymmetry > 1e-12 * np.abs(self.M).max():
+            raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
+        try:
+            object.__setattr__(self, "_cholesky", (np.linalg.cholesky(self.M), True))
+        except np.linalg.LinAlgError:
+            raise InvalidProblem("M is not positive definite") from None
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            inverse = _cho_solve(self._cholesky, np.eye(self.n))
+        if not all_finite(inverse):
+            self._too_close_to_singular()
+        if self.n <= SMALL:
+            inverse.flags.writeable = False
+            object.__setattr__(self, "_inverse", inverse)
+        return float(inverse.diagonal().max())
+
+    def _too_close_to_singular(self) -> NoReturn:
+        diagonal = np.diag(self.M)
+        raise InvalidProblem(
+            f"M is too close to singular: its inverse overflows (smallest diagonal entry "
+            f"M[{int(np.argmin(diagonal))}, {int(np.argmin(diagonal))}] = {diagonal.min():.3g})"
+        )
+
+    def _check_normals(self, inverse_mass: float) -> None:
         """Refuse a contact that no motion can push along its normal (a singular configuration).
 
         Its normal Delassus entry is then rounding noise (for example a pendulum hanging
         straight down onto the floor), and every law's impulse would be meaningless.
+        ``inverse_mass`` is the largest diagonal entry of M^-1, within a factor n of its largest
+        eigenvalue: scale enough for a test at rounding level.
         """
-        W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
-        reciprocal = self.__dict__.get("_inverse_diagonal")
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            if reciprocal is not None:
-                inverse = reciprocal[:, None]
-            else:
-                inverse = _cho_solve(self._cholesky, np.eye(self.n))
-        if not np.isfinite(inverse).all():
-            diagonal = np.diag(self.M)
-            raise InvalidProblem(
-                f"M is too close to singular: its inverse overflows (smallest diagonal entry "
-                f"M[{int(np.argmin(diagonal))}, {int(np.argmin(diagonal))}] = {diagonal.min():.3g})"
-            )
         if self.n <= SMALL:
-            inverse.flags.writeable = False
-            object.__setattr__(self, "_inverse", inverse)
-        # The largest diagonal entry of M^-1 is within a factor n of its largest eigenvalue:
-        # scale enough for a test at rounding level.
-        inverse_mass = float(inverse.max() if reciprocal is not None else np.diag(inverse).max())
-        scale = inverse_mass * float((W**2).sum(axis=0).max())
-        normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
+            # The Delassus matrix is cheap here and every law needs it: its diagonal serves.
+            normal = self.delassus.diagonal()
+        else:
+            normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
+        # The squared Frobenius norm of W bounds its largest squared column: one product
+        # settles the usual case.
+        if normal.min() > 1e-12 * inverse_mass * float(np.vdot(self.W, self.W)):
+            return
+        scale = inverse_mass * float(np.einsum("ij,ij->j", self.W, self.W).max())
         for j in np.flatnonzero(normal <= 1e-12 * scale):
             raise InvalidProblem(
                 f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 Wn[:, {j}]"
@@ -318,10 +399,31 @@ class ImpactProblem:
         """Whether some contact has a tangential Jacobian and a positive mu."""
         return self.Wt is not None and any(c.mu > 0 for c in self.contacts)
 
-    @property
+    @cached_property
     def closed(self) -> np.ndarray:
         """Boolean mask of the contacts with zero gap, the ones an impact involves."""
-        return self.gaps <= 0.0
+        closed = self.gaps <= 0.0
+        closed.flags.writeable = False
+        return closed
+
+    @cached_property
+    def closed_count(self) -> int:
+        """Number of closed contacts."""
+        return self.m - int(np.count_nonzero(self.gaps))
+
+    @cached_property
+    def separating(self) -> tuple[int, ...]:
+        """Closed contacts whose gap rate is positive before the impact (they separate)."""
+        if self.un.max() <= 0.0:
+            return ()
+        scale = float(np.abs(self.un).max())
+        separating = self.closed & (self.un > SEPARATING * (scale or 1.0))
+        return tuple(int(j) for j in np.flatnonzero(separating))
+
+    @cached_property
+    def T_minus(self) -> float:
+        """Kinetic energy before the impact, ``v @ M @ v / 2`` (inf when it overflows)."""
+        return kinetic_energy(self.M, self.v)
 
     def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
         """Return ``M^-1 @ rhs``: the cached inverse of a small M, else its Cholesky factor."""
@@ -357,7 +459,9 @@ class ImpactProblem:
     @cached_property
     def un(self) -> np.ndarray:
         """Pre-impact normal gap rates ``Wn.T @ v``."""
-        return self.Wn.T @ self.v
+        un = self.Wn.T @ self.v
+        un.flags.writeable = False
+        return un
 
     @cached_property
     def W(self) -> np.ndarray:
@@ -390,17 +494,19 @@ class ImpactProblem:
 
     def restitution(self, kind: str) -> np.ndarray:
         """Per-contact restitution coefficients of ``kind`` ('newton', 'poisson', 'energy')."""
-        if kind not in RESTITUTION_KINDS:
-            raise ValueError(f"unknown restitution kind {kind!r}")
-        return self._restitutions[kind]
+        coefficients = self._restitutions.get(kind)
+        if coefficients is None:
+            if kind not in RESTITUTION_KINDS:
+                raise ValueError(f"unknown restitution kind {kind!r}")
+            coefficients = np.array([c.restitution(kind) for c in self.contacts])
+            coefficients.flags.writeable = False
+            self._restitutions[kind] = coefficients
+        return coefficients
 
     @cached_property
     def _restitutions(self) -> dict[str, np.ndarray]:
-        coefficients = {}
-        for kind in RESTITUTION_KINDS:
-            coefficients[kind] = np.array([c.restitution(kind) for c in self.contacts])
-            coefficients[kind].flags.writeable = False
-        return coefficients
+        """The coefficients of each kind asked for so far."""
+        return {}
 
     def select_contacts(self, mask: np.ndarray) -> ImpactProblem:
         """Return the problem restricted to the contacts where ``mask`` is true."""

@@ -158,26 +158,69 @@ def _active_sets(m: int) -> tuple[np.ndarray, ...]:
 
 
 def _solve_blocks(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Solve the stacked systems ``A[k] x[k] = b[k]``.
+    """Solve the stacked systems ``A[k] x[k] = b[k]`` of three rows or more.
 
-    Blocks of one and two rows by their closed forms (a singular one gives non-finite numbers,
-    which the caller rejects); larger ones by LU, or their least-norm solution when singular.
+    By LU, or their least-norm solution when one is singular (the caller rejects the answer).
     """
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        warnings.simplefilter("ignore", RuntimeWarning)
-        if A.shape[-1] == 1:
-            return b / A[..., 0]
-        if A.shape[-1] == 2:
-            a, c, d = A[..., 0, 0], A[..., 0, 1], A[..., 1, 1]
-            det = a * d - c * A[..., 1, 0]
-            return (
-                np.stack([(d * b[..., 0] - c * b[..., 1]), (a * b[..., 1] - c * b[..., 0])], -1)
-                / det[..., None]
-            )
-        try:
-            return np.linalg.solve(A, b[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            return (np.linalg.pinv(A) @ b[..., None])[..., 0]
+    try:
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return (np.linalg.pinv(A) @ b[..., None])[..., 0]
+
+
+def _solve_set(
+    G: list[list[np.ndarray]], q: list[np.ndarray], active: tuple[int, ...]
+) -> list[np.ndarray]:
+    """The impulses of the ``active`` contacts that zero their slack, for a stack of problems.
+
+    ``G`` and ``q`` are given entry by entry (arrays over the stack). Blocks of one and two rows
+    by their closed forms (a singular one gives non-finite numbers, which the caller rejects);
+    larger ones by `_solve_blocks`.
+    """
+    if not active:
+        return []
+    if len(active) == 1:
+        (i,) = active
+        return [-q[i] / G[i][i]]
+    if len(active) == 2:
+        i, j = active
+        a, c, d = G[i][i], G[i][j], G[j][j]
+        det = a * d - c * G[j][i]
+        return [(d * -q[i] - c * -q[j]) / det, (a * -q[j] - c * -q[i]) / det]
+    block = np.stack([np.stack([G[i][j] for j in active], -1) for i in active], -2)
+    solved = _solve_blocks(block, np.stack([-q[i] for i in active], -1))
+    return [solved[:, k] for k in range(len(active))]
+
+
+def _enumerate_batch(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`enumerate_lcp` for a stack of problems, G (B, m, m) and q (B, m).
+
+    Each entry of G, q and z is one array over the stack, so that every step is an elementwise
+    operation on B numbers: numpy's reductions over a handful of contacts are slow. The tests
+    are those of the one-problem path (an inactive contact's zero impulse passes them).
+    """
+    batch, m = q.shape
+    g = [[G[:, i, j] for j in range(m)] for i in range(m)]
+    rhs = [q[:, i] for i in range(m)]
+    z = [np.zeros(batch) for _ in range(m)]
+    found = np.zeros(batch, dtype=bool)
+    floor = -COMPLEMENTARITY * functools.reduce(np.maximum, map(np.abs, rhs), ROUNDING)
+    for active in _active_sets(m):
+        if found.all():
+            break
+        with np.errstate(all="ignore"):
+            solved = _solve_set(g, rhs, tuple(active.tolist()))
+            scale = functools.reduce(np.maximum, map(np.abs, solved), ROUNDING)
+            good = ~found
+            for x in solved:
+                good &= np.isfinite(x) & (x >= -COMPLEMENTARITY * scale)
+            for i in range(m):
+                terms = [g[i][j] * x for j, x in zip(active.tolist(), solved, strict=True)]
+                good &= sum(terms, start=0.0) + rhs[i] >= floor
+        for j, x in zip(active.tolist(), solved, strict=True):
+            z[j] = np.where(good, np.maximum(x, 0.0), z[j])
+        found |= good
+    return np.stack(z, axis=-1), found
 
 
 def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -201,44 +244,62 @@ def enumerate_lcp(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     """
     q = np.asarray(q, dtype=float)
     if q.ndim == 1 and np.ndim(G) == 2:
-        return _enumerate_one(np.asarray(G, dtype=float), q)
+        solved = _enumerate_one(np.asarray(G, dtype=float), q)
+        if solved is None:
+            return np.zeros_like(q), np.array(False)
+        return solved[0], np.array(True)
     batch, m = q.shape[:-1], q.shape[-1]
-    qs = q.reshape(-1, m)
-    Gs = np.broadcast_to(np.asarray(G, dtype=float), (*batch, m, m)).reshape(-1, m, m)
-    z = np.zeros_like(qs)
-    found = np.zeros(len(qs), dtype=bool)
-    velocity_scale = np.maximum(np.abs(qs).max(axis=1, initial=0.0), ROUNDING)
-    for active in _active_sets(m):
-        if found.all():
-            break
-        candidate = np.zeros_like(qs)
-        if active.size:
-            block = Gs[:, active[:, None], active]
-            candidate[:, active] = _solve_blocks(block, -qs[:, active])
-        with np.errstate(all="ignore"):
-            slack = np.einsum("kij,kj->ki", Gs, candidate) + qs
-            impulse_scale = np.maximum(np.abs(candidate).max(axis=1), ROUNDING)
-            good = (
-                ~found
-                & np.isfinite(candidate).all(axis=1)
-                & (candidate.min(axis=1) >= -COMPLEMENTARITY * impulse_scale)
-                & (slack.min(axis=1) >= -COMPLEMENTARITY * velocity_scale)
-            )
-        z[good] = np.maximum(candidate[good], 0.0)
-        found |= good
+    G = np.broadcast_to(np.asarray(G, dtype=float), (*batch, m, m)).reshape(-1, m, m)
+    z, found = _enumerate_batch(G, q.reshape(-1, m))
     return z.reshape(*batch, m), found.reshape(batch)
 
 
-def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """`enumerate_lcp` for one problem: ``(z, w = G z + q)``, or None where no set is found.
+
+    One problem of a few contacts is dominated by the cost of calling numpy, so it is solved in
+    Python floats: two contacts by their closed form, more by the same enumeration.
+    """
+    solved = _two_contacts(G, q) if len(q) == 2 else _enumerate_sets(G, q)
+    return None if solved is None else (np.array(solved[0]), np.array(solved[1]))
+
+
+def _two_contacts(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float]] | None:
+    """The LCP of two contacts in closed form, as `enumerate_lcp` solves it.
+
+    The active sets {}, {0}, {1}, {0, 1} in that order, each set's equations solved by the
+    formulas of `_solve_set` and held to the same tests, so the answer is the same.
+    """
+    (a, b), (c, d) = G.tolist()
+    q0, q1 = q.tolist()
+    det = a * d - b * c
+    candidates = (
+        (0.0, 0.0),
+        (-q0 / a if a else math.inf, 0.0),
+        (0.0, -q1 / d if d else math.inf),
+        ((d * -q0 - b * -q1) / det, (a * -q1 - b * -q0) / det) if det else (math.inf, 0.0),
+    )
+    floor = -COMPLEMENTARITY * max(abs(q0), abs(q1), ROUNDING)
+    for z0, z1 in candidates:
+        if not (math.isfinite(z0) and math.isfinite(z1)):
+            continue
+        if min(z0, z1) < -COMPLEMENTARITY * max(abs(z0), abs(z1), ROUNDING):
+            continue
+        if min(a * z0 + b * z1 + q0, c * z0 + d * z1 + q1) >= floor:
+            z0, z1 = max(z0, 0.0), max(z1, 0.0)
+            return [z0, z1], [a * z0 + b * z1 + q0, c * z0 + d * z1 + q1]
+    return None
+
+
+def _enumerate_sets(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float]] | None:
     """`enumerate_lcp` for one problem, in Python floats: the same sets, formulas and tests.
 
-    One problem of a few contacts is dominated by the cost of calling numpy, so the blocks of
-    one and two rows are solved with the same closed forms in plain arithmetic (identical in
-    IEEE double), and only larger blocks go through LU.
+    Blocks of one and two rows are solved with the closed forms of `_solve_set` in plain
+    arithmetic (identical in IEEE double), and only larger blocks go through LU.
     """
     m = len(q)
     rows, rhs = G.tolist(), q.tolist()
-    velocity_scale = max(max(abs(x) for x in rhs), ROUNDING)
+    floor = -COMPLEMENTARITY * max(max(abs(x) for x in rhs), ROUNDING)
     for active in _active_sets(m):
         candidate = [0.0] * m
         if len(active) == 1:
@@ -253,7 +314,8 @@ def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray
             candidate[i] = (d * -rhs[i] - c * -rhs[j]) / det
             candidate[j] = (a * -rhs[j] - c * -rhs[i]) / det
         elif len(active) > 2:
-            solved = _solve_blocks(G[np.ix_(active, active)][None], -q[active][None])[0]
+            with np.errstate(all="ignore"):
+                solved = _solve_blocks(G[np.ix_(active, active)][None], -q[active][None])[0]
             for i, x in zip(active.tolist(), solved.tolist(), strict=True):
                 candidate[i] = x
         if not all(math.isfinite(x) for x in candidate):
@@ -261,13 +323,17 @@ def _enumerate_one(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray
         impulse_scale = max(max(abs(x) for x in candidate), ROUNDING)
         if min(candidate) < -COMPLEMENTARITY * impulse_scale:
             continue
-        slack = [
-            sum(g * x for g, x in zip(row, candidate, strict=True)) + b
-            for row, b in zip(rows, rhs, strict=True)
-        ]
-        if min(slack) >= -COMPLEMENTARITY * velocity_scale:
-            return np.maximum(np.array(candidate), 0.0), np.array(True)
-    return np.zeros(m), np.array(False)
+        if min(_affine(rows, candidate, rhs)) >= floor:
+            z = [max(x, 0.0) for x in candidate]
+            return z, _affine(rows, z, rhs)
+    return None
+
+
+def _affine(rows: list[list[float]], z: list[float], q: list[float]) -> list[float]:
+    """``G z + q`` in Python floats, G given by its rows."""
+    return [
+        sum(g * x for g, x in zip(row, z, strict=True)) + b for row, b in zip(rows, q, strict=True)
+    ]
 
 
 def solve_lcp(
@@ -297,9 +363,9 @@ def solve_lcp(
         method = "closed form" if len(q) == 1 else "decoupled (diagonal Delassus)"
         return LCPResult(z, G @ z + q, method)
     if len(q) <= ENUMERATION_MAX:
-        z, found = enumerate_lcp(G, q)
-        if found:
-            return LCPResult(z, G @ z + q, "LCP (active-set enumeration)")
+        solved = _enumerate_one(G, q)
+        if solved is not None:
+            return LCPResult(*solved, "LCP (active-set enumeration)")
     if method == "nnls":
         return _nnls_lcp(G, q)
     result = clarabel_qp(G, q, np.eye(len(q)), tol)

@@ -64,7 +64,6 @@ class Tags:
             return "the problem has friction (mu > 0) and this law is frictionless"
         if problem.d == 2 and problem.frictional and not self.spatial:
             return "the problem is spatial (two tangential directions) and this law is planar"
-        closed = int(problem.closed.sum())
-        if closed > 1 and not self.several_contacts:
-            return f"the problem has {closed} closed contacts and this law treats one"
+        if problem.closed_count > 1 and not self.several_contacts:
+            return f"the problem has {problem.closed_count} closed contacts and this law treats one"
         return None

@@ -205,8 +205,8 @@ class Moreau(Law):
             restituted = un
         if problem.frictional:
             return _resolve_friction(problem, e * restituted, options)
-        single_e = len(set(e)) == 1 and np.array_equal(restituted, un)
         large = problem.m > ENUMERATION_MAX
+        single_e = large and len(set(e)) == 1 and np.array_equal(restituted, un)
         if single_e and large and not is_diagonal(problem.delassus):
             plastic = project_on_cone(
                 problem.M,

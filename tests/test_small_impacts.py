@@ -1,0 +1,123 @@
+"""Small impacts: closed forms, work done once per problem, and batches of problems.
+
+An LCP of one or two contacts is solved in closed form instead of by the generic enumeration;
+a problem is validated when built and keeps what it computed, so it can be resolved many times;
+a batch carries the enumeration over every problem at once. Each gives the general path's
+answer: the same numbers bit for bit where the formulas are the same, else to 1e-12.
+"""
+
+import numpy as np
+import pytest
+
+import lawbench
+from lawbench import Contact, ImpactProblem, InvalidProblem
+from lawbench.solvers import _enumerate_sets, clarabel_qp, enumerate_lcp, polish, solve_lcp
+
+
+def random_lcps(rng, count, m, decades=2.0):
+    """Symmetric positive definite G and q of either sign, scaled over +-``decades``."""
+    A = rng.normal(size=(count, m, m)) * 10.0 ** rng.uniform(-decades, decades, (count, 1, 1))
+    G = A @ np.swapaxes(A, 1, 2) + 1e-3 * np.eye(m)
+    q = rng.normal(size=(count, m)) * 10.0 ** rng.uniform(-decades, decades, (count, 1))
+    return G, q
+
+
+@pytest.mark.parametrize("m", [1, 2])
+def test_the_closed_form_equals_the_enumeration_bit_for_bit(m):
+    G, q = random_lcps(np.random.default_rng(m), 500, m)
+    together, found = enumerate_lcp(G, q)
+    assert found.all()
+    for k in range(len(q)):
+        alone = solve_lcp(G[k], q[k])
+        generic, slack = _enumerate_sets(G[k], q[k])
+        assert np.array_equal(alone.z, generic), k
+        assert np.array_equal(alone.z, together[k]), k
+        np.testing.assert_allclose(alone.w, slack, rtol=0, atol=1e-15 * np.abs(q[k]).max())
+        assert alone.method == ("closed form" if m == 1 else "LCP (active-set enumeration)")
+
+
+@pytest.mark.parametrize("m", [1, 2])
+def test_the_closed_form_equals_clarabel_polished(m):
+    """clarabel's interior point, refined on its active set, is exact to rounding too (on
+    moderately scaled problems, where its absolute tolerances find the active set)."""
+    G, q = random_lcps(np.random.default_rng(10 + m), 100, m, decades=0.5)
+    for k in range(len(q)):
+        approximate = clarabel_qp(G[k], q[k], np.eye(m), 1e-10).x
+        exact = polish(G[k], q[k], np.maximum(approximate, 0.0))
+        assert exact is not None
+        z = solve_lcp(G[k], q[k]).z
+        assert np.abs(z - exact).max() <= 1e-12 * max(np.abs(exact).max(), 1e-300), k
+
+
+def test_a_singular_pair_of_contacts_falls_back_to_a_single_contact():
+    """Two identical normals: the pair's equations are singular, one contact takes it all."""
+    z, found = enumerate_lcp(np.ones((2, 2)), np.array([-1.0, -1.0]))
+    assert found and np.array_equal(z, [1.0, 0.0])
+
+
+def test_a_batch_with_full_mass_matrices_and_own_jacobians_equals_one_by_one():
+    rng = np.random.default_rng(3)
+    count, n, m = 200, 4, 2
+    A = rng.normal(size=(count, n, n))
+    M = A @ np.swapaxes(A, 1, 2) + np.eye(n)
+    Wn = rng.normal(size=(count, n, m))
+    v = rng.normal(size=(count, n))
+    e = rng.uniform(0.0, 1.0, (count, m))
+    batch = lawbench.ProblemBatch(M, Wn, v, {"e": e})
+    together = lawbench.solve_batch("moreau", batch)
+    moreau = lawbench.LAWS.get("moreau")
+    for k in range(count):
+        alone = moreau.resolve(batch.problem(k))
+        assert np.abs(together.v_plus[k] - alone.v_plus).max() <= 1e-12 * np.abs(v[k]).max()
+        assert together.T_plus[k] == pytest.approx(alone.T_plus, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("arrays", "coefficients", "message"),
+    [
+        ({"Wn": [[-1.0], [np.nan]]}, {}, r"Wn\[0, 1, 0\] = nan"),
+        ({}, {"e": [[0.5], [np.nan]]}, r"problem 1: contacts\[0\]\.e = nan"),
+        ({"M": np.diag([1.0, 1e-320])}, {}, "problem 0: M is too close to singular"),
+    ],
+)
+def test_a_batch_names_the_bad_entry_of_a_shared_array(arrays, coefficients, message):
+    fields = {"M": np.eye(2), "Wn": [[-1.0], [1.0]], "v": np.ones((2, 2))} | arrays
+    with pytest.raises(InvalidProblem, match=message):
+        lawbench.ProblemBatch(fields["M"], fields["Wn"], fields["v"], coefficients)
+
+
+def test_a_prebuilt_problem_is_resolved_many_times_without_validation(monkeypatch):
+    problem = lawbench.CASES.get("three_ball_chain").build(e=0.9)
+    first = {name: lawbench.solve(name, problem) for name in ("moreau", "newton", "poisson")}
+
+    def validated_again(*args, **kwargs):
+        raise AssertionError("validated again")
+
+    for name in ("_factor_mass", "_check_normals"):
+        monkeypatch.setattr(ImpactProblem, name, validated_again)
+    monkeypatch.setattr(Contact, "validate", validated_again)
+    for _ in range(3):
+        for name, outcome in first.items():
+            again = lawbench.solve(name, problem)
+            assert np.array_equal(again.v_plus, outcome.v_plus)
+            assert again.T_plus == outcome.T_plus
+
+
+@pytest.mark.parametrize(
+    ("coefficients", "message"),
+    [({"e": 1.5}, r"contacts\[0\]\.e = 1\.5"), ({"e": [0.5, -0.5]}, r"contacts\[1\]\.e = -0\.5")],
+)
+def test_shared_and_per_contact_coefficients_are_validated_by_name(coefficients, message):
+    chain = [[-1.0, 0.0], [1.0, -1.0], [0.0, 1.0]]
+    with pytest.raises(InvalidProblem, match=message):
+        ImpactProblem.from_arrays(np.eye(3), chain, [1.0, 0.0, 0.0], **coefficients)
+
+
+def test_a_small_diagonal_mass_is_inverted_exactly():
+    M = np.diag([1e-3, 3.0, 7e3])
+    problem = ImpactProblem.from_arrays(M, [[-1.0], [1.0], [0.0]], [1.0, 0.0, 0.0])
+    rhs = np.array([1.0, 2.0, 3.0])
+    np.testing.assert_allclose(problem.solve_mass(rhs), rhs / np.diag(M), rtol=1e-15)
+    np.testing.assert_allclose(problem.delassus, [[1e3 + 1 / 3]], rtol=1e-15)
+    with pytest.raises(InvalidProblem, match="M is too close to singular"):
+        ImpactProblem.from_arrays(np.diag([1.0, 1e-320]), [[-1.0], [1.0]], [1.0, 0.0])
