@@ -41,7 +41,6 @@ class Event:
     x: float
     y: np.ndarray
     fired: tuple[int, ...]
-    step: float
 
 
 class EventIntegrator:
@@ -93,7 +92,6 @@ class EventIntegrator:
         x_end: float = np.inf,
         jac: Callable | None = None,
         on_step: Callable[[Dense, float, float], None] | None = None,
-        first_step: float | None = None,
     ) -> Event | None:
         """Integrate from ``(x0, y0)`` to just past the first event, or None at ``x_end``.
 
@@ -114,9 +112,6 @@ class EventIntegrator:
             The field's Jacobian, for the implicit methods.
         on_step : callable or None
             ``on_step(dense, x_old, x)`` after each step, the last one ending at the event.
-        first_step : float or None
-            The first step to try (an earlier event's ``step``, where the field after it has
-            the same scales); None lets the solver choose it.
 
         Raises
         ------
@@ -127,8 +122,6 @@ class EventIntegrator:
         """
         spend = budget.current()
         extra = {} if jac is None else {"jac": jac}
-        if first_step is not None:
-            extra["first_step"] = min(first_step, x_end - x0)
         solver = self.method(fun, x0, y0, x_end, rtol=self.rtol, atol=self.atol, **extra)
         direction = np.asarray(direction, dtype=float)
         before = np.asarray(events(x0, y0), dtype=float)
@@ -145,7 +138,7 @@ class EventIntegrator:
                 crossed = np.flatnonzero(_fires(before, after, direction))
                 if crossed.size:
                     spend.event()
-                    event = self._locate(events, dense, crossed, start, x, solver.step_size)
+                    event = self._locate(events, dense, crossed, start, x)
                     if on_step is not None:
                         on_step(dense, solver.t_old, event.x)
                     return event
@@ -161,7 +154,6 @@ class EventIntegrator:
         crossed: np.ndarray,
         lo: float,
         hi: float,
-        step: float,
     ) -> Event:
         def value(i: int, x: float) -> float:
             return float(events(x, dense(x))[i])
@@ -170,7 +162,7 @@ class EventIntegrator:
         order = np.argsort(where, kind="stable")
         x = float(where[order[0]])
         together = where[order] <= x + self.simultaneous
-        return Event(x, dense(x), tuple(int(i) for i in crossed[order][together]), step)
+        return Event(x, dense(x), tuple(int(i) for i in crossed[order][together]))
 
 
 def _fires(before: np.ndarray, after: np.ndarray, direction: np.ndarray) -> np.ndarray:

@@ -28,8 +28,7 @@ at closure, which can be near zero, makes the damping unbounded); Hertz is elast
 Numerics: scipy's ``solve_ivp`` (DOP853 by default) in scaled variables (velocities over the
 largest approach speed V, lengths over the largest static indentation scale, time over their
 ratio), restarted at every event where a force law changes branch (a contact closes, opens,
-or its force crosses zero), so the right-hand side is smooth between restarts; a restart tries
-the step the integration last took (the time scale does not change at an event). The impact ends
+or its force crosses zero), so the right-hand side is smooth between restarts. The impact ends
 when every contact is open and none approaches. The accuracy knob is ``tol`` (atol = tol
 times 1e-3 in scaled units). Order of convergence: the error of ``v_plus`` against a
 tight-tolerance reference falls in proportion to tol (slope 1 in log-log; on the three-ball
@@ -258,12 +257,9 @@ class _Integration:
         t, self.steps, events = 0.0, 0, 0
         self.peak = np.zeros(m)
         self.history: list[tuple[float, np.ndarray]] = [(0.0, y)]
-        step = None
         while not self.ended(y):
-            event = integrator.to_event(
-                self.rhs, t, y, self._switches, on_step=self._on_step, first_step=step
-            )
-            t, y, events, step = event.x, event.y, events + 1, event.step
+            event = integrator.to_event(self.rhs, t, y, self._switches, on_step=self._on_step)
+            t, y, events = event.x, event.y, events + 1
         diagnostics = {
             "formulation": f"time integration ({self.model}, {options['method']})",
             "duration_s": t * self.tau,

@@ -152,25 +152,3 @@ def turning_slip_problem() -> lawbench.ImpactProblem:
         v=-v if Wn[:, 0] @ v > 0 else v,
         contacts=[lawbench.Contact(e=0.5, mu=0.8)],
     )
-
-
-def test_a_restart_may_carry_the_last_step_over():
-    """The zeros of sin t at pi and 2 pi, the second found from a restart at the first with
-    the step the first run ended on: same location, fewer steps than a fresh choice."""
-    integrator = EventIntegrator(rtol=1e-12, atol=1e-14)
-    first = integrator.to_event(harmonic, 0.0, np.array([0.0, 1.0]), lambda t, y: y[:1], -1.0)
-    counts = []
-    for step in (None, first.step):
-        steps = []
-        second = integrator.to_event(
-            harmonic,
-            first.x,
-            first.y,
-            lambda t, y: y[:1],
-            1.0,
-            on_step=lambda dense, t_old, t, steps=steps: steps.append(t),
-            first_step=step,
-        )
-        assert second.x == pytest.approx(2 * math.pi, rel=1e-12)
-        counts.append(len(steps))
-    assert first.step > 0 and counts[1] < counts[0]
