@@ -52,6 +52,9 @@ class Law(ABC):
     # How the law treats a closed contact that separates before the impact, stated in the
     # diagnostics of every problem that has one; a law that states no rule refuses them.
     separating_rule: ClassVar[str] = ""
+    # Whether `_resolve` takes a sparse problem (scipy.sparse M, Wn and Delassus matrix); a law
+    # that does not receives it with numpy arrays.
+    takes_sparse: ClassVar[bool] = False
 
     def rule_for_separating(self, options: dict[str, Any]) -> str:
         """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
@@ -116,6 +119,8 @@ class Law(ABC):
                 f"{self.name}: closed contacts {separating} separate before the impact, and the "
                 "law states no rule for them"
             )
+        if problem.sparse and not self.takes_sparse:
+            problem = problem.dense()
         closed = problem.closed
         start = time.perf_counter()
         if closed.all() or self.follows_gaps:

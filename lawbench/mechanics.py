@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lawbench.problem import ImpactProblem
+from lawbench.problem import ImpactProblem, has_off_diagonal
 
 
 def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
@@ -47,8 +47,8 @@ def separating_contacts(problem: ImpactProblem) -> list[int]:
 
 
 def is_diagonal(G: np.ndarray) -> bool:
-    """Whether the Delassus matrix decouples the contacts (no off-diagonal term)."""
-    return not np.any(G - np.diag(np.diag(G)))
+    """Whether the Delassus matrix (dense or sparse) decouples the contacts."""
+    return not has_off_diagonal(G)
 
 
 def kinetic_angles(problem: ImpactProblem) -> np.ndarray:

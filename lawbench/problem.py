@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -22,6 +24,17 @@ RESTITUTION_KINDS = ("newton", "poisson", "energy")
 SMALL = 64
 # A matrix with at most this share of non-zero entries is multiplied as a sparse one.
 SPARSE_SHARE = 0.05
+# Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
+SOLVE_BLOCK = 256
+
+
+def is_sparse(value: object) -> bool:
+    """Whether ``value`` is a scipy.sparse matrix or array.
+
+    Without scipy.sparse imported no value can be one, so small problems never import it.
+    """
+    module = sys.modules.get("scipy.sparse")
+    return module is not None and bool(module.issparse(value))
 
 
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
@@ -110,6 +123,8 @@ def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray
 
 def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`."""
+    if is_sparse(value):
+        value = value.toarray()
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -121,6 +136,63 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
         raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
     array.flags.writeable = False
     return array
+
+
+def _sparse_matrix(name: str, value: object, shape: tuple[int, int]) -> Any:
+    """Return ``value`` as a read-only CSC array of ``shape``, or raise `InvalidProblem`.
+
+    The checks cost O(nnz): only the stored entries are read.
+    """
+    import scipy.sparse
+
+    try:
+        matrix = scipy.sparse.csc_array(value, dtype=float, copy=True)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{name}: not a matrix of numbers ({exc})") from None
+    if matrix.shape != shape:
+        raise InvalidProblem(f"{name} has shape {matrix.shape}, expected {shape}")
+    matrix.sum_duplicates()
+    bad = np.flatnonzero(~np.isfinite(matrix.data))
+    if bad.size:
+        k = int(bad[0])
+        column = int(np.searchsorted(matrix.indptr, k, side="right")) - 1
+        raise InvalidProblem(
+            f"{name}{[int(matrix.indices[k]), column]} = {matrix.data[k]}: must be finite"
+        )
+    matrix.eliminate_zeros()
+    for part in (matrix.data, matrix.indices, matrix.indptr):
+        part.flags.writeable = False
+    return matrix
+
+
+def _sparse_factor(M: Any) -> Any:
+    """Sparse LU factor of a symmetric M with symmetric ordering and no pivoting, or None.
+
+    Without pivoting the factor is ``P M P.T = L D L.T`` written as ``L U``: M is positive
+    definite exactly when every pivot, the diagonal of U, is positive.
+    """
+    import scipy.sparse.linalg
+
+    try:
+        factor = scipy.sparse.linalg.splu(
+            M,
+            permc_spec="MMD_AT_PLUS_A",
+            diag_pivot_thresh=0.0,
+            options={"SymmetricMode": True},
+        )
+    except RuntimeError:  # an exactly singular pivot
+        return None
+    if not np.array_equal(factor.perm_r, factor.perm_c) or (factor.U.diagonal() <= 0).any():
+        return None
+    return factor
+
+
+def has_off_diagonal(M: Any) -> bool:
+    """Whether M (dense or sparse) has a non-zero entry off its diagonal."""
+    if isinstance(M, np.ndarray):
+        return bool(np.count_nonzero(M - np.diag(np.diag(M))))
+    coo = M.tocoo()
+    return bool(np.any(coo.data[coo.row != coo.col]))
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,15 +246,17 @@ class ImpactProblem:
                 raise InvalidProblem(f"contacts[{j}] is {type(contact).__name__}, not Contact")
             contact.validate(f"contacts[{j}]")
         set_ = object.__setattr__
+        sparse = n > SMALL and any(is_sparse(a) for a in (self.M, self.Wn, self.Wt))
+        matrix = _sparse_matrix if sparse else _matrix
         set_(self, "v", _matrix("v", v, (n,)))
-        set_(self, "M", _matrix("M", self.M, (n, n)))
-        set_(self, "Wn", _matrix("Wn", self.Wn, (n, m)))
+        set_(self, "M", matrix("M", self.M, (n, n)))
+        set_(self, "Wn", matrix("Wn", self.Wn, (n, m)))
         set_(self, "contacts", contacts)
         if self.Wt is not None:
             d = np.shape(self.Wt)[1] // m if np.ndim(self.Wt) == 2 else 0
             if d not in (1, 2):
                 raise InvalidProblem(f"Wt has shape {np.shape(self.Wt)}, expected ({n}, {m}*d)")
-            set_(self, "Wt", _matrix("Wt", self.Wt, (n, m * d)))
+            set_(self, "Wt", matrix("Wt", self.Wt, (n, m * d)))
         gaps = np.zeros(m) if self.gaps is None else self.gaps
         set_(self, "gaps", _matrix("gaps", gaps, (m,)))
         if (self.gaps < 0).any():
@@ -193,25 +267,37 @@ class ImpactProblem:
             if any(i < 0 or i >= n for i in idx):
                 raise InvalidProblem(f"bodies[{name!r}] = {idx}: indices must lie in [0, {n})")
         set_(self, "bodies", bodies)
-        asymmetry = np.abs(self.M - self.M.T).max()
-        if asymmetry > 1e-12 * np.abs(self.M).max():
+        asymmetry = abs(self.M - self.M.T).max()
+        if asymmetry > 1e-12 * abs(self.M).max():
             raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
-        diagonal = np.diag(self.M)
-        if self.n > SMALL and not np.count_nonzero(self.M - np.diag(diagonal)):
-            # Bodies that are points or decoupled coordinates: M^-1 is the reciprocal diagonal.
-            if not (diagonal > 0).all():
-                raise InvalidProblem("M is not positive definite")
-            set_(self, "_inverse_diagonal", 1.0 / diagonal)
-        else:
-            try:
-                set_(self, "_cholesky", (np.linalg.cholesky(self.M), True))
-            except np.linalg.LinAlgError:
-                raise InvalidProblem("M is not positive definite") from None
+        self._factor_mass()
         self._check_normals()
         with np.errstate(over="ignore", invalid="ignore"):
             energy = float(self.v @ self.M @ self.v)
         if not math.isfinite(energy):
             raise InvalidProblem(f"v and M give a kinetic energy that overflows ({energy})")
+
+    def _factor_mass(self) -> None:
+        """Keep what solves with M: its reciprocal diagonal, sparse LU or Cholesky factor.
+
+        Raises `InvalidProblem` when M is not positive definite.
+        """
+        diagonal = self.M.diagonal()
+        if self.n > SMALL and not has_off_diagonal(self.M):
+            # Bodies that are points or decoupled coordinates: M^-1 is the reciprocal diagonal.
+            if not (diagonal > 0).all():
+                raise InvalidProblem("M is not positive definite")
+            object.__setattr__(self, "_inverse_diagonal", 1.0 / diagonal)
+        elif self.sparse:
+            factor = _sparse_factor(self.M)
+            if factor is None:
+                raise InvalidProblem("M is not positive definite")
+            object.__setattr__(self, "_sparse_factor", factor)
+        else:
+            try:
+                object.__setattr__(self, "_cholesky", (np.linalg.cholesky(self.M), True))
+            except np.linalg.LinAlgError:
+                raise InvalidProblem("M is not positive definite") from None
 
     @classmethod
     def from_arrays(
@@ -271,15 +357,18 @@ class ImpactProblem:
         Its normal Delassus entry is then rounding noise (for example a pendulum hanging
         straight down onto the floor), and every law's impulse would be meaningless.
         """
-        W = self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
         reciprocal = self.__dict__.get("_inverse_diagonal")
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            if reciprocal is None and self.sparse:
+                # (M^-1)_ii >= 1 / M_ii (Cauchy-Schwarz): a lower bound of the scale below,
+                # without the inverse.
+                reciprocal = 1.0 / self.M.diagonal()
             if reciprocal is not None:
                 inverse = reciprocal[:, None]
             else:
                 inverse = _cho_solve(self._cholesky, np.eye(self.n))
         if not np.isfinite(inverse).all():
-            diagonal = np.diag(self.M)
+            diagonal = self.M.diagonal()
             raise InvalidProblem(
                 f"M is too close to singular: its inverse overflows (smallest diagonal entry "
                 f"M[{int(np.argmin(diagonal))}, {int(np.argmin(diagonal))}] = {diagonal.min():.3g})"
@@ -290,8 +379,11 @@ class ImpactProblem:
         # The largest diagonal entry of M^-1 is within a factor n of its largest eigenvalue:
         # scale enough for a test at rounding level.
         inverse_mass = float(inverse.max() if reciprocal is not None else np.diag(inverse).max())
-        scale = inverse_mass * float((W**2).sum(axis=0).max())
-        normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
+        scale = inverse_mass * float((self.W**2).sum(axis=0).max())
+        if self.sparse:
+            normal = (self.Wn * self._mass_solved(self.Wn)).sum(axis=0)
+        else:
+            normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
         for j in np.flatnonzero(normal <= 1e-12 * scale):
             raise InvalidProblem(
                 f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 Wn[:, {j}]"
@@ -323,34 +415,81 @@ class ImpactProblem:
         """Boolean mask of the contacts with zero gap, the ones an impact involves."""
         return self.gaps <= 0.0
 
-    def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
-        """Return ``M^-1 @ rhs``: the cached inverse of a small M, else its Cholesky factor."""
+    @property
+    def sparse(self) -> bool:
+        """Whether M, Wn and Wt are scipy.sparse CSC arrays (a large problem given sparse).
+
+        Then `delassus`, `W` and `contact_delassus` are sparse too; `dense` gives the problem
+        with arrays.
+        """
+        return is_sparse(self.M)
+
+    def dense(self) -> ImpactProblem:
+        """The same problem with numpy arrays in place of sparse ones (itself when dense)."""
+        if not self.sparse:
+            return self
+        Wt = None if self.Wt is None else self.Wt.toarray()
+        return dataclasses.replace(self, M=self.M.toarray(), Wn=self.Wn.toarray(), Wt=Wt)
+
+    def solve_mass(self, rhs: Any) -> Any:
+        """Return ``M^-1 @ rhs``.
+
+        The cached inverse of a small M, the reciprocal diagonal, or M's (sparse LU or
+        Cholesky) factor; a sparse ``rhs`` gives a sparse answer.
+        """
+        if is_sparse(rhs):
+            return self._mass_solved(rhs)
         inverse = self.__dict__.get("_inverse")
         if inverse is not None:
             return inverse @ rhs
         reciprocal = self.__dict__.get("_inverse_diagonal")
         if reciprocal is not None:
             return reciprocal[:, None] * rhs if np.ndim(rhs) == 2 else reciprocal * rhs
+        factor = self.__dict__.get("_sparse_factor")
+        if factor is not None:
+            return factor.solve(np.asarray(rhs, dtype=float))
         return _cho_solve(self._cholesky, rhs)
 
+    def _mass_solved(self, W: Any) -> Any:
+        """``M^-1 W`` of a sparse ``W`` as a CSC array, in O(nnz) for a diagonal M.
+
+        Through M's sparse factor ``SOLVE_BLOCK`` columns at a time, keeping non-zero entries.
+        """
+        import scipy.sparse
+
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None:
+            return scipy.sparse.csc_array(W.multiply(reciprocal[:, None]))
+        if not self.sparse:
+            return scipy.sparse.csc_array(self.solve_mass(W.toarray()))
+        blocks = [
+            scipy.sparse.csc_array(self.solve_mass(W[:, k : k + SOLVE_BLOCK].toarray()))
+            for k in range(0, W.shape[1], SOLVE_BLOCK)
+        ]
+        return scipy.sparse.hstack(blocks, format="csc")
+
+    def _sparse_delassus(self, W: Any) -> Any:
+        """``W.T M^-1 W`` of a sparse ``W``, symmetrized, as a CSC array."""
+        G = W.T @ self._mass_solved(W)
+        return ((G + G.T) / 2).tocsc()
+
     @cached_property
-    def delassus(self) -> np.ndarray:
-        """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse."""
+    def delassus(self) -> Any:
+        """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse.
+
+        Sparse for a sparse problem.
+        """
+        if self.sparse:
+            return self._sparse_delassus(self.Wn)
         if self.n > SMALL and np.count_nonzero(self.Wn) <= SPARSE_SHARE * self.Wn.size:
             # Chains and columns: each contact moves two bodies, so G is banded; the sparse
             # product costs O(nnz) instead of O(n m^2).
             import scipy.sparse
 
-            Wn = scipy.sparse.csc_matrix(self.Wn)
-            reciprocal = self.__dict__.get("_inverse_diagonal")
-            if reciprocal is not None:
-                moved = Wn.multiply(reciprocal[:, None]).tocsc()
-            else:
-                moved = scipy.sparse.csc_matrix(self.solve_mass(self.Wn))
-            G = (Wn.T @ moved).toarray()
+            G = self._sparse_delassus(scipy.sparse.csc_array(self.Wn)).toarray()
         else:
             G = self.Wn.T @ self.solve_mass(self.Wn)
-        G = (G + G.T) / 2
+            G = (G + G.T) / 2
         G.flags.writeable = False
         return G
 
@@ -360,17 +499,26 @@ class ImpactProblem:
         return self.Wn.T @ self.v
 
     @cached_property
-    def W(self) -> np.ndarray:
+    def W(self) -> Any:
         """Contact Jacobian ``[Wn, Wt]`` (n, m + m*d): normal columns, then tangential."""
-        return self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
+        if self.Wt is None:
+            return self.Wn
+        if self.sparse:
+            import scipy.sparse
+
+            return scipy.sparse.hstack([self.Wn, self.Wt], format="csc")
+        return np.hstack([self.Wn, self.Wt])
 
     @cached_property
-    def contact_delassus(self) -> np.ndarray:
+    def contact_delassus(self) -> Any:
         """Delassus matrix of normal and tangential directions ``W.T M^-1 W``.
 
         Blocks: ``[[Gnn, Gnt], [Gtn, Gtt]]`` with the m normal rows first, then the m*d
         tangential rows (contact j's tangential rows are ``m + j*d ... m + j*d + d - 1``).
+        Sparse for a sparse problem.
         """
+        if self.sparse:
+            return self._sparse_delassus(self.W)
         G = self.W.T @ self.solve_mass(self.W)
         G = (G + G.T) / 2
         G.flags.writeable = False
@@ -407,7 +555,8 @@ class ImpactProblem:
         mask = np.asarray(mask, dtype=bool)
         Wt = None
         if self.Wt is not None:
-            Wt = self.Wt.reshape(self.n, self.m, self.d)[:, mask, :].reshape(self.n, -1)
+            columns = np.flatnonzero(mask)[:, None] * self.d + np.arange(self.d)
+            Wt = self.Wt[:, columns.ravel()]
         return dataclasses.replace(
             self,
             Wn=self.Wn[:, mask],

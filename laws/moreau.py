@@ -120,6 +120,7 @@ class Moreau(Law):
         "2011; Anitescu 2006"
     )
     tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="tol")
+    takes_sparse = True
 
     def rule_for_separating(self, options: dict[str, Any]) -> str:
         """The rule of option ``separating``."""
@@ -205,7 +206,7 @@ class Moreau(Law):
         else:
             restituted = un
         if problem.frictional:
-            return _resolve_friction(problem, e * restituted, options)
+            return _resolve_friction(problem.dense(), e * restituted, options)
         single_e = len(set(e)) == 1 and np.array_equal(restituted, un)
         large = problem.m > ENUMERATION_MAX
         if single_e and large and not is_diagonal(problem.delassus):
