@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lawbench.problem import ImpactProblem, has_off_diagonal
+from lawbench.problem import ImpactProblem, as_array, has_off_diagonal
 
 
 def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
@@ -59,7 +59,7 @@ def kinetic_angles(problem: ImpactProblem) -> np.ndarray:
     rigid laws with e > 0 are continuous in the initial data only where the angles are right
     angles (orthogonal constraints).
     """
-    G = problem.delassus
+    G = as_array(problem.delassus)
     scale = np.sqrt(np.diag(G))
     cosine = np.clip(G / np.outer(scale, scale), -1.0, 1.0)
     return np.degrees(np.arccos(cosine))

@@ -37,6 +37,11 @@ def is_sparse(value: object) -> bool:
     return module is not None and bool(module.issparse(value))
 
 
+def as_array(value: Any) -> np.ndarray:
+    """``value`` as a numpy array: a scipy.sparse one densified, any other as it is."""
+    return value.toarray() if is_sparse(value) else value
+
+
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
     """Raise `InvalidProblem` unless ``low <= value <= high`` (``high`` None: unbounded)."""
     if not math.isfinite(value):

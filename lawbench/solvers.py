@@ -31,7 +31,7 @@ import scipy.sparse.linalg
 
 from lawbench.errors import SolverFailure
 from lawbench.mechanics import is_diagonal
-from lawbench.problem import SPARSE_SHARE, is_sparse
+from lawbench.problem import SPARSE_SHARE, as_array, is_sparse
 
 ROUNDING = 1e-12
 # Contacts up to which active-set enumeration (2**m sets) is the exact, cheap method.
@@ -306,19 +306,14 @@ def solve_lcp(
         method = "closed form" if len(q) == 1 else "decoupled (diagonal Delassus)"
         return LCPResult(z, G @ z + q, method)
     if len(q) <= ENUMERATION_MAX:
-        z, found = enumerate_lcp(_dense(G), q)
+        z, found = enumerate_lcp(as_array(G), q)
         if found:
             return LCPResult(z, G @ z + q, "LCP (active-set enumeration)")
     if method == "nnls":
-        return _nnls_lcp(_dense(G), q)
+        return _nnls_lcp(as_array(G), q)
     identity = scipy.sparse.identity(len(q), format="csc") if is_sparse(G) else np.eye(len(q))
     result = clarabel_qp(G, q, identity, tol)
     return _finish(G, q, result.x, result, refine)
-
-
-def _dense(G: np.ndarray) -> np.ndarray:
-    """``G`` as a numpy array, for the methods of a few contacts or a dense factorization."""
-    return G.toarray() if is_sparse(G) else G
 
 
 def _nnls_lcp(G: np.ndarray, q: np.ndarray) -> LCPResult:
