@@ -204,17 +204,21 @@ def has_off_diagonal(M: Any) -> bool:
 class ImpactProblem:
     """An impact at a frozen configuration, validated when built.
 
+    ``M``, ``Wn`` and ``Wt`` may be scipy.sparse matrices. Beyond ``SMALL`` coordinates the
+    problem then keeps all three as CSC arrays (`sparse`), checks them in O(nnz) and solves
+    with M through its reciprocal diagonal or one sparse LU factor; a smaller one is densified.
+
     Parameters
     ----------
-    M : array (n, n)
+    M : array or scipy.sparse matrix (n, n)
         Symmetric positive definite mass matrix in generalized coordinates.
-    Wn : array (n, m)
+    Wn : array or scipy.sparse matrix (n, m)
         Normal Jacobian: ``un = Wn.T @ v`` is the gap rate of the m contacts.
     v : array (n,)
         Pre-impact generalized velocity.
     contacts : sequence of Contact
         One entry per contact.
-    Wt : array (n, m*d) or None
+    Wt : array or scipy.sparse matrix (n, m*d), or None
         Tangential Jacobian, d = 1 (planar) or 2 (spatial); None without friction.
     bodies : mapping of str to sequence of int
         Body name -> indices of its generalized coordinates (for energy shares).
