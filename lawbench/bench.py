@@ -26,9 +26,13 @@ import scipy.sparse
 
 from lawbench.api import solve_batch
 from lawbench.batch import ProblemBatch
+from lawbench.chains import chain_problem
 from lawbench.law import LAWS
 from lawbench.problem import ImpactProblem
 from lawbench.solvers import clarabel_settings, enumerate_lcp
+
+# Chain lengths of the full report: the growth from 1,000 to 10,000 balls shows the cost per ball.
+CHAINS = (100, 1000, 10_000)
 
 
 def median_time(function: Callable[[], Any], repeats: int, number: int = 1) -> float:
@@ -52,10 +56,13 @@ def chain_arrays(balls: int, rng: np.random.Generator) -> tuple[np.ndarray, ...]
     return np.diag(masses), Wn, v
 
 
-def clarabel_direct(M: np.ndarray, Wn: np.ndarray, v: np.ndarray, e: float) -> np.ndarray:
-    """Moreau's frictionless impulses with clarabel, called directly on the sparse LCP's QP."""
+def clarabel_direct(M: Any, Wn: Any, v: np.ndarray, e: float) -> np.ndarray:
+    """Moreau's frictionless impulses with clarabel, called directly on the sparse LCP's QP.
+
+    ``M`` (diagonal) and ``Wn`` are numpy or scipy.sparse arrays.
+    """
     Wn_sparse = scipy.sparse.csc_matrix(Wn)
-    inverse_mass = scipy.sparse.diags(1.0 / np.diag(M))
+    inverse_mass = scipy.sparse.diags(1.0 / M.diagonal())
     G = (Wn_sparse.T @ inverse_mass @ Wn_sparse).tocsc()
     q = (1.0 + e) * (Wn.T @ v)
     m = Wn.shape[1]
@@ -77,30 +84,35 @@ def numpy_enumeration(M: np.ndarray, Wn: np.ndarray, v: np.ndarray, e: float) ->
 
 
 # Siconos numerics (the reference nonsmooth-mechanics library, C) is measured when the
-# interpreter below imports it (Debian: python3-siconos): Lemke on the same three-ball LCP,
-# building its matrix and vector included, one call at a time.
+# interpreter below imports it (Debian: python3-siconos): Lemke on the same chain's LCP (its
+# matrix is dense), building its matrix and vector included, ``number`` calls at a time.
 SICONOS_PYTHON = os.environ.get("LAWBENCH_SICONOS_PYTHON", "/usr/bin/python3")
 SICONOS_SCRIPT = """
 import time, numpy as np, siconos.numerics as sn
-masses, v, e = np.array({masses}), np.array({v}), 0.9
-Wn = np.zeros((3, 2)); Wn[[0, 1], [0, 1]] = -1.0; Wn[[1, 2], [0, 1]] = 1.0
+masses, v, e = np.array({masses}), np.array({v}), {e}
+n = len(masses); index = np.arange(n - 1)
+Wn = np.zeros((n, n - 1)); Wn[index, index] = -1.0; Wn[index + 1, index] = 1.0
 def one():
     D = Wn.T @ (Wn / masses[:, None]); q = (1.0 + e) * (Wn.T @ v)
-    z, w = np.zeros(2), np.zeros(2)
+    z, w = np.zeros(n - 1), np.zeros(n - 1)
     sn.lcp_lexicolemke(sn.LCP(D, q), z, w, sn.SolverOptions(sn.SICONOS_LCP_LEMKE))
     return z
 times = []
 for _ in range({repeats}):
     start = time.perf_counter()
-    for _ in range(200): one()
-    times.append((time.perf_counter() - start) / 200)
+    for _ in range({number}): one()
+    times.append((time.perf_counter() - start) / {number})
 print(sorted(times)[len(times) // 2])
 """
 
 
-def siconos_lemke(masses: np.ndarray, v: np.ndarray, repeats: int) -> float | None:
-    """Median seconds per three-ball Lemke solve in Siconos numerics, or None if absent."""
-    script = SICONOS_SCRIPT.format(masses=masses.tolist(), v=v.tolist(), repeats=repeats)
+def siconos_lemke(
+    masses: np.ndarray, v: np.ndarray, repeats: int, number: int = 200, e: float = 0.9
+) -> float | None:
+    """Median seconds per Lemke solve of a free chain in Siconos numerics, or None if absent."""
+    script = SICONOS_SCRIPT.format(
+        masses=masses.tolist(), v=v.tolist(), e=e, repeats=repeats, number=number
+    )
     try:
         done = subprocess.run(
             [SICONOS_PYTHON, "-c", script], capture_output=True, text=True, timeout=120
@@ -173,15 +185,35 @@ def batch_of_impacts(size: int, repeats: int) -> list[str]:
     ]
 
 
-def long_chains(sizes: tuple[int, ...], repeats: int) -> list[str]:
-    """Moreau on n-ball chains against clarabel called directly on the sparse QP."""
+def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) -> list[str]:
+    """Moreau on n-ball chains, built as the chain scenes build them (sparse when long).
+
+    Against clarabel called directly on the sparse QP and, up to ``siconos_up_to`` balls,
+    Siconos' Lemke on the dense LCP; the last line is the growth exponent of lawbench's time
+    between the two longest chains.
+    """
     moreau, lines = LAWS.get("moreau"), ["Moreau on an n-ball chain (e = 0.5):"]
+    times = []
     for balls in sizes:
-        M, Wn, v = chain_arrays(balls, np.random.default_rng(balls))
-        direct = median_time(lambda M=M, Wn=Wn, v=v: clarabel_direct(M, Wn, v, 0.5), repeats)
-        problem = ImpactProblem.from_arrays(M, Wn, v, e=0.5)
-        ours = median_time(lambda p=problem: moreau.resolve(p), repeats)
-        lines.append(_row(f"n = {balls}, prebuilt problem", ours, {"clarabel direct": direct}))
+        rng = np.random.default_rng(balls)
+        masses = 10.0 ** rng.uniform(-1.0, 1.0, balls)
+        v = np.sort(rng.uniform(0.0, 1.0, balls))[::-1].copy()
+        ones = [1.0] * (balls - 1)
+        pairs = [(i, i + 1) for i in range(balls - 1)]
+        problem = chain_problem(masses, v, pairs, [0.5] * (balls - 1), ones, ones)
+        peers = {
+            "clarabel direct": median_time(
+                lambda p=problem: clarabel_direct(p.M, p.Wn, p.v, 0.5), repeats
+            )
+        }
+        siconos = siconos_lemke(masses, v, 3, 1, 0.5) if balls <= siconos_up_to else None
+        if siconos is not None:
+            peers["Siconos Lemke"] = siconos
+        times.append(median_time(lambda p=problem: moreau.resolve(p), repeats))
+        lines.append(_row(f"n = {balls}, prebuilt problem", times[-1], peers))
+    if len(sizes) > 1:
+        growth = np.log(times[-1] / times[-2]) / np.log(sizes[-1] / sizes[-2])
+        lines.append(f"  time grows like n^{growth:.2f} from n = {sizes[-2]} to {sizes[-1]}")
     return lines
 
 
@@ -210,7 +242,7 @@ def report(quick: bool = False) -> str:
         + ", ".join(f"{k}={v}" for k, v in threads.items()),
         *small_impact(repeats),
         *batch_of_impacts(10_000 if quick else 100_000, repeats),
-        *long_chains((100,) if quick else (100, 1000), repeats),
+        *(long_chains((100, 1000), repeats) if quick else long_chains(CHAINS, repeats, 1000)),
         *start_up(repeats),
     ]
     return "\n".join(lines)

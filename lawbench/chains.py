@@ -8,6 +8,7 @@ ball indices, the right ball being on the positive side of the left one, so the 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -15,6 +16,9 @@ from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
 
 Pair = tuple[int | None, int | None]
+# Beyond this many contacts a chain's M and Wn are scipy.sparse: dense n x n storage and
+# products would dominate its cost, and Moreau's law solves it sparse end to end.
+SPARSE_CONTACTS = 256
 
 
 def chain_problem(
@@ -40,24 +44,39 @@ def chain_problem(
         Initial gaps (m); zero by default.
     """
     n = len(masses)
-    Wn = np.zeros((n, len(pairs)))
-    for j, (left, right) in enumerate(pairs):
-        if left is not None:
-            Wn[left, j] = -1.0
-        if right is not None:
-            Wn[right, j] = 1.0
+    M, Wn = _mass_and_normals(np.asarray(masses, dtype=float), pairs)
     contacts = [
         Contact(e=e, stiffness=k, exponent=n)
         for e, k, n in zip(restitution, stiffness, exponents, strict=True)
     ]
     return ImpactProblem(
-        M=np.diag(np.asarray(masses, dtype=float)),
+        M=M,
         Wn=Wn,
         v=np.asarray(velocities, dtype=float),
         contacts=contacts,
         bodies={f"ball {i + 1}": (i,) for i in range(n)},
         gaps=None if gaps is None else np.asarray(gaps, dtype=float),
     )
+
+
+def _mass_and_normals(masses: np.ndarray, pairs: Sequence[Pair]) -> tuple[Any, Any]:
+    """Diagonal mass matrix and normal Jacobian: arrays, or CSC beyond `SPARSE_CONTACTS`."""
+    entries = [
+        (ball, j, sign)
+        for j, pair in enumerate(pairs)
+        for ball, sign in zip(pair, (-1.0, 1.0), strict=True)
+        if ball is not None
+    ]
+    rows, columns, signs = (np.array(values) for values in zip(*entries, strict=True))
+    shape = (len(masses), len(pairs))
+    if len(pairs) <= SPARSE_CONTACTS:
+        Wn = np.zeros(shape)
+        Wn[rows, columns] = signs
+        return np.diag(masses), Wn
+    import scipy.sparse
+
+    Wn = scipy.sparse.csc_array((signs, (rows, columns)), shape=shape)
+    return scipy.sparse.diags_array(masses, format="csc"), Wn
 
 
 def ball_velocities(n: int) -> list[str]:

@@ -55,6 +55,9 @@ class Law(ABC):
     # How the law treats a closed contact that separates before the impact, stated in the
     # diagnostics of every problem that has one; a law that states no rule refuses them.
     separating_rule: ClassVar[str] = ""
+    # Whether `_resolve` takes a sparse problem (scipy.sparse M, Wn and Delassus matrix); a law
+    # that does not receives it with numpy arrays.
+    takes_sparse: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         """Give every law the wall-clock budget ``max_seconds`` (`lawbench.budget`)."""
@@ -125,6 +128,8 @@ class Law(ABC):
                 f"{self.name}: closed contacts {separating} separate before the impact, and the "
                 "law states no rule for them"
             )
+        if problem.sparse and not self.takes_sparse:
+            problem = problem.dense()
         start = time.perf_counter()
         with budget.Budget.of(self.name, values):
             if problem.closed_count == problem.m or self.follows_gaps:

@@ -27,7 +27,7 @@ from lawbench.checks.dispersion import dispersion_index as _index
 from lawbench.errors import LawbenchError
 from lawbench.law import LAWS
 from lawbench.mechanics import energy_shares as _shares
-from lawbench.problem import ImpactProblem
+from lawbench.problem import ImpactProblem, is_sparse
 from lawbench.study import tightest
 
 # Answers solved again, per process: (law, options, problem) -> v_plus or None.
@@ -37,8 +37,12 @@ _SOLVED: dict[str, np.ndarray | None] = {}
 def _digest(problem: ImpactProblem) -> str:
     digest = hashlib.sha1(repr(problem.contacts).encode())
     for part in (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps):
-        if part is not None:
-            digest.update(np.ascontiguousarray(part, dtype=float).tobytes())
+        if part is None:
+            continue
+        # A sparse matrix by its stored entries and their places (CSC, as the problem keeps it).
+        arrays = (part.data, part.indices, part.indptr) if is_sparse(part) else (part,)
+        for array in arrays:
+            digest.update(np.ascontiguousarray(array).tobytes())
     return digest.hexdigest()
 
 

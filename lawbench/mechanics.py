@@ -6,7 +6,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lawbench.problem import SMALL, SPARSE_SHARE, ImpactProblem, kinetic_energy
+from lawbench.problem import (
+    SMALL,
+    SPARSE_SHARE,
+    ImpactProblem,
+    as_array,
+    has_off_diagonal,
+    kinetic_energy,
+)
 
 if TYPE_CHECKING:
     import scipy.sparse
@@ -40,8 +47,8 @@ def separating_contacts(problem: ImpactProblem) -> list[int]:
 
 
 def is_diagonal(G: np.ndarray) -> bool:
-    """Whether the Delassus matrix decouples the contacts (no off-diagonal term)."""
-    return np.count_nonzero(G) == np.count_nonzero(G.diagonal())
+    """Whether the Delassus matrix (dense or sparse) decouples the contacts."""
+    return not has_off_diagonal(G)
 
 
 def kinetic_angles(problem: ImpactProblem) -> np.ndarray:
@@ -52,7 +59,7 @@ def kinetic_angles(problem: ImpactProblem) -> np.ndarray:
     rigid laws with e > 0 are continuous in the initial data only where the angles are right
     angles (orthogonal constraints).
     """
-    G = problem.delassus
+    G = as_array(problem.delassus)
     scale = np.sqrt(np.diag(G))
     cosine = np.clip(G / np.outer(scale, scale), -1.0, 1.0)
     return np.degrees(np.arccos(cosine))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Generic, NoReturn, TypeVar, overload
@@ -71,6 +72,24 @@ def all_finite(array: np.ndarray) -> bool:
     reduction; only a non-finite sum (which overflow can also give) is looked at entry by entry.
     """
     return math.isfinite(array.sum()) or bool(np.isfinite(array).all())
+
+
+# Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
+SOLVE_BLOCK = 256
+
+
+def is_sparse(value: object) -> bool:
+    """Whether ``value`` is a scipy.sparse matrix or array.
+
+    Without scipy.sparse imported no value can be one, so small problems never import it.
+    """
+    module = sys.modules.get("scipy.sparse")
+    return module is not None and bool(module.issparse(value))
+
+
+def as_array(value: Any) -> np.ndarray:
+    """``value`` as a numpy array: a scipy.sparse one densified, any other as it is."""
+    return value.toarray() if is_sparse(value) else value
 
 
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
@@ -162,6 +181,8 @@ def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray
 
 def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`."""
+    if is_sparse(value):
+        value = value.toarray()
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -175,21 +196,82 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     return array
 
 
+def _sparse_matrix(name: str, value: object, shape: tuple[int, int]) -> Any:
+    """Return ``value`` as a read-only CSC array of ``shape``, or raise `InvalidProblem`.
+
+    The checks cost O(nnz): only the stored entries are read.
+    """
+    import scipy.sparse
+
+    try:
+        matrix = scipy.sparse.csc_array(value, dtype=float, copy=True)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{name}: not a matrix of numbers ({exc})") from None
+    if matrix.shape != shape:
+        raise InvalidProblem(f"{name} has shape {matrix.shape}, expected {shape}")
+    matrix.sum_duplicates()
+    bad = np.flatnonzero(~np.isfinite(matrix.data))
+    if bad.size:
+        k = int(bad[0])
+        column = int(np.searchsorted(matrix.indptr, k, side="right")) - 1
+        raise InvalidProblem(
+            f"{name}{[int(matrix.indices[k]), column]} = {matrix.data[k]}: must be finite"
+        )
+    matrix.eliminate_zeros()
+    for part in (matrix.data, matrix.indices, matrix.indptr):
+        part.flags.writeable = False
+    return matrix
+
+
+def _sparse_factor(M: Any) -> Any:
+    """Sparse LU factor of a symmetric M with symmetric ordering and no pivoting, or None.
+
+    Without pivoting the factor is ``P M P.T = L D L.T`` written as ``L U``: M is positive
+    definite exactly when every pivot, the diagonal of U, is positive.
+    """
+    import scipy.sparse.linalg
+
+    try:
+        factor = scipy.sparse.linalg.splu(
+            M,
+            permc_spec="MMD_AT_PLUS_A",
+            diag_pivot_thresh=0.0,
+            options={"SymmetricMode": True},
+        )
+    except RuntimeError:  # an exactly singular pivot
+        return None
+    if not np.array_equal(factor.perm_r, factor.perm_c) or (factor.U.diagonal() <= 0).any():
+        return None
+    return factor
+
+
+def has_off_diagonal(M: Any) -> bool:
+    """Whether M (dense or sparse) has a non-zero entry off its diagonal."""
+    if isinstance(M, np.ndarray):
+        return np.count_nonzero(M) != np.count_nonzero(M.diagonal())
+    coo = M.tocoo()
+    return bool(np.any(coo.data[coo.row != coo.col]))
+
+
 @dataclass(frozen=True, eq=False)
 class ImpactProblem:
     """An impact at a frozen configuration, validated when built.
 
+    ``M``, ``Wn`` and ``Wt`` may be scipy.sparse matrices. Beyond ``SMALL`` coordinates the
+    problem then keeps all three as CSC arrays (`sparse`), checks them in O(nnz) and solves
+    with M through its reciprocal diagonal or one sparse LU factor; a smaller one is densified.
+
     Parameters
     ----------
-    M : array (n, n)
+    M : array or scipy.sparse matrix (n, n)
         Symmetric positive definite mass matrix in generalized coordinates.
-    Wn : array (n, m)
+    Wn : array or scipy.sparse matrix (n, m)
         Normal Jacobian: ``un = Wn.T @ v`` is the gap rate of the m contacts.
     v : array (n,)
         Pre-impact generalized velocity.
     contacts : sequence of Contact
         One entry per contact.
-    Wt : array (n, m*d) or None
+    Wt : array or scipy.sparse matrix (n, m*d), or None
         Tangential Jacobian, d = 1 (planar) or 2 (spatial); None without friction.
     bodies : mapping of str to sequence of int
         Body name -> indices of its generalized coordinates (for energy shares).
@@ -228,15 +310,17 @@ class ImpactProblem:
                 raise InvalidProblem(f"contacts[{j}] is {type(contact).__name__}, not Contact")
             contact.validate(f"contacts[{j}]")
         set_ = object.__setattr__
+        sparse = n > SMALL and any(is_sparse(a) for a in (self.M, self.Wn, self.Wt))
+        matrix = _sparse_matrix if sparse else _matrix
         set_(self, "v", _matrix("v", v, (n,)))
-        set_(self, "M", _matrix("M", self.M, (n, n)))
-        set_(self, "Wn", _matrix("Wn", self.Wn, (n, m)))
+        set_(self, "M", matrix("M", self.M, (n, n)))
+        set_(self, "Wn", matrix("Wn", self.Wn, (n, m)))
         set_(self, "contacts", contacts)
         if self.Wt is not None:
             d = np.shape(self.Wt)[1] // m if np.ndim(self.Wt) == 2 else 0
             if d not in (1, 2):
                 raise InvalidProblem(f"Wt has shape {np.shape(self.Wt)}, expected ({n}, {m}*d)")
-            set_(self, "Wt", _matrix("Wt", self.Wt, (n, m * d)))
+            set_(self, "Wt", matrix("Wt", self.Wt, (n, m * d)))
         if self.gaps is None:
             gaps = np.zeros(m)
             gaps.flags.writeable = False
@@ -318,10 +402,11 @@ class ImpactProblem:
         """Check that M is symmetric positive definite and keep what `solve_mass` uses.
 
         A diagonal M (points, decoupled coordinates) is inverted exactly by its reciprocal
-        diagonal; any other by its Cholesky factor. Returns the largest diagonal entry of M^-1.
+        diagonal; any other by its Cholesky factor, or its sparse LU factor when sparse.
+        Returns the largest diagonal entry of M^-1 (a lower bound of it when sparse).
         """
         diagonal = self.M.diagonal()
-        if np.count_nonzero(self.M) == np.count_nonzero(diagonal):
+        if not has_off_diagonal(self.M):
             smallest = float(diagonal.min())
             if not smallest > 0:
                 raise InvalidProblem("M is not positive definite")
@@ -332,9 +417,17 @@ class ImpactProblem:
             object.__setattr__(self, "_inverse_diagonal", reciprocal)
             # Rounded division is monotone: the largest reciprocal is that of the smallest mass.
             return 1.0 / smallest
-        asymmetry = np.abs(self.M - self.M.T).max()
-        if asymmetry > 1e-12 * np.abs(self.M).max():
+        asymmetry = abs(self.M - self.M.T).max()
+        if asymmetry > 1e-12 * abs(self.M).max():
             raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
+        if self.sparse:
+            factor = _sparse_factor(self.M)
+            if factor is None:
+                raise InvalidProblem("M is not positive definite")
+            object.__setattr__(self, "_sparse_factor", factor)
+            # (M^-1)_ii >= 1 / M_ii (Cauchy-Schwarz): a bound without the inverse, enough for
+            # a test at rounding level.
+            return float((1.0 / diagonal).max())
         try:
             object.__setattr__(self, "_cholesky", (np.linalg.cholesky(self.M), True))
         except np.linalg.LinAlgError:
@@ -363,16 +456,22 @@ class ImpactProblem:
         ``inverse_mass`` is the largest diagonal entry of M^-1, within a factor n of its largest
         eigenvalue: scale enough for a test at rounding level.
         """
-        if self.n <= SMALL:
+        if self.sparse:
+            normal = (self.Wn * self._mass_solved(self.Wn)).sum(axis=0)
+            columns = (self.W * self.W).sum(axis=0)
+        elif self.n <= SMALL:
             # The Delassus matrix is cheap here and every law needs it: its diagonal serves.
-            normal = self.delassus.diagonal()
+            normal, columns = self.delassus.diagonal(), None
         else:
-            normal = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn))
+            normal, columns = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn)), None
         # The squared Frobenius norm of W bounds its largest squared column: one product
         # settles the usual case.
-        if normal.min() > 1e-12 * inverse_mass * float(np.vdot(self.W, self.W)):
+        total = float(columns.sum()) if columns is not None else float(np.vdot(self.W, self.W))
+        if normal.min() > 1e-12 * inverse_mass * total:
             return
-        scale = inverse_mass * float(np.einsum("ij,ij->j", self.W, self.W).max())
+        if columns is None:
+            columns = np.einsum("ij,ij->j", self.W, self.W)
+        scale = inverse_mass * float(columns.max())
         for j in np.flatnonzero(normal <= 1e-12 * scale):
             raise InvalidProblem(
                 f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 Wn[:, {j}]"
@@ -425,34 +524,81 @@ class ImpactProblem:
         """Kinetic energy before the impact, ``v @ M @ v / 2`` (inf when it overflows)."""
         return kinetic_energy(self.M, self.v)
 
-    def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
-        """Return ``M^-1 @ rhs``: the cached inverse of a small M, else its Cholesky factor."""
+    @property
+    def sparse(self) -> bool:
+        """Whether M, Wn and Wt are scipy.sparse CSC arrays (a large problem given sparse).
+
+        Then `delassus`, `W` and `contact_delassus` are sparse too; `dense` gives the problem
+        with arrays.
+        """
+        return is_sparse(self.M)
+
+    def dense(self) -> ImpactProblem:
+        """The same problem with numpy arrays in place of sparse ones (itself when dense)."""
+        if not self.sparse:
+            return self
+        Wt = None if self.Wt is None else self.Wt.toarray()
+        return dataclasses.replace(self, M=self.M.toarray(), Wn=self.Wn.toarray(), Wt=Wt)
+
+    def solve_mass(self, rhs: Any) -> Any:
+        """Return ``M^-1 @ rhs``.
+
+        The cached inverse of a small M, the reciprocal diagonal, or M's (sparse LU or
+        Cholesky) factor; a sparse ``rhs`` gives a sparse answer.
+        """
+        if is_sparse(rhs):
+            return self._mass_solved(rhs)
         inverse = self.__dict__.get("_inverse")
         if inverse is not None:
             return inverse @ rhs
         reciprocal = self.__dict__.get("_inverse_diagonal")
         if reciprocal is not None:
             return reciprocal[:, None] * rhs if np.ndim(rhs) == 2 else reciprocal * rhs
+        factor = self.__dict__.get("_sparse_factor")
+        if factor is not None:
+            return factor.solve(np.asarray(rhs, dtype=float))
         return _cho_solve(self._cholesky, rhs)
 
+    def _mass_solved(self, W: Any) -> Any:
+        """``M^-1 W`` of a sparse ``W`` as a CSC array, in O(nnz) for a diagonal M.
+
+        Through M's sparse factor ``SOLVE_BLOCK`` columns at a time, keeping non-zero entries.
+        """
+        import scipy.sparse
+
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None:
+            return scipy.sparse.csc_array(W.multiply(reciprocal[:, None]))
+        if not self.sparse:
+            return scipy.sparse.csc_array(self.solve_mass(W.toarray()))
+        blocks = [
+            scipy.sparse.csc_array(self.solve_mass(W[:, k : k + SOLVE_BLOCK].toarray()))
+            for k in range(0, W.shape[1], SOLVE_BLOCK)
+        ]
+        return scipy.sparse.hstack(blocks, format="csc")
+
+    def _sparse_delassus(self, W: Any) -> Any:
+        """``W.T M^-1 W`` of a sparse ``W``, symmetrized, as a CSC array."""
+        G = W.T @ self._mass_solved(W)
+        return ((G + G.T) / 2).tocsc()
+
     @cached_property
-    def delassus(self) -> np.ndarray:
-        """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse."""
+    def delassus(self) -> Any:
+        """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse.
+
+        Sparse for a sparse problem.
+        """
+        if self.sparse:
+            return self._sparse_delassus(self.Wn)
         if self.n > SMALL and np.count_nonzero(self.Wn) <= SPARSE_SHARE * self.Wn.size:
             # Chains and columns: each contact moves two bodies, so G is banded; the sparse
             # product costs O(nnz) instead of O(n m^2).
             import scipy.sparse
 
-            Wn = scipy.sparse.csc_matrix(self.Wn)
-            reciprocal = self.__dict__.get("_inverse_diagonal")
-            if reciprocal is not None:
-                moved = Wn.multiply(reciprocal[:, None]).tocsc()
-            else:
-                moved = scipy.sparse.csc_matrix(self.solve_mass(self.Wn))
-            G = (Wn.T @ moved).toarray()
+            G = self._sparse_delassus(scipy.sparse.csc_array(self.Wn)).toarray()
         else:
             G = self.Wn.T @ self.solve_mass(self.Wn)
-        G = (G + G.T) / 2
+            G = (G + G.T) / 2
         G.flags.writeable = False
         return G
 
@@ -464,17 +610,26 @@ class ImpactProblem:
         return un
 
     @cached_property
-    def W(self) -> np.ndarray:
+    def W(self) -> Any:
         """Contact Jacobian ``[Wn, Wt]`` (n, m + m*d): normal columns, then tangential."""
-        return self.Wn if self.Wt is None else np.hstack([self.Wn, self.Wt])
+        if self.Wt is None:
+            return self.Wn
+        if self.sparse:
+            import scipy.sparse
+
+            return scipy.sparse.hstack([self.Wn, self.Wt], format="csc")
+        return np.hstack([self.Wn, self.Wt])
 
     @cached_property
-    def contact_delassus(self) -> np.ndarray:
+    def contact_delassus(self) -> Any:
         """Delassus matrix of normal and tangential directions ``W.T M^-1 W``.
 
         Blocks: ``[[Gnn, Gnt], [Gtn, Gtt]]`` with the m normal rows first, then the m*d
         tangential rows (contact j's tangential rows are ``m + j*d ... m + j*d + d - 1``).
+        Sparse for a sparse problem.
         """
+        if self.sparse:
+            return self._sparse_delassus(self.W)
         G = self.W.T @ self.solve_mass(self.W)
         G = (G + G.T) / 2
         G.flags.writeable = False
@@ -513,7 +668,8 @@ class ImpactProblem:
         mask = np.asarray(mask, dtype=bool)
         Wt = None
         if self.Wt is not None:
-            Wt = self.Wt.reshape(self.n, self.m, self.d)[:, mask, :].reshape(self.n, -1)
+            columns = np.flatnonzero(mask)[:, None] * self.d + np.arange(self.d)
+            Wt = self.Wt[:, columns.ravel()]
         return dataclasses.replace(
             self,
             Wn=self.Wn[:, mask],

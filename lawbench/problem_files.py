@@ -21,8 +21,10 @@ The extension decides the encoding. ``.json`` is readable: matrices are nested l
 written with Python's shortest round-trip repr, so every float is read back bit for bit.
 ``.npz`` and ``.h5``/``.hdf5`` hold arrays; a matrix whose entries are mostly zero (sparse
 chains) is stored as CSR triplets (``<name>.data``, ``.indices``, ``.indptr``, ``.shape``), so a
-large sparse problem stays small on disk. ``bodies`` and ``contacts`` are stored as JSON text in
-the array files. HDF5 needs h5py (``pip install 'lawbench[hdf5]'``).
+large sparse problem stays small on disk. A problem built with scipy.sparse matrices is marked
+``sparse`` (true) and read back with them; JSON writes its matrices dense. ``bodies`` and
+``contacts`` are stored as JSON text in the array files. HDF5 needs h5py
+(``pip install 'lawbench[hdf5]'``).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ import numpy as np
 import scipy.sparse
 
 from lawbench.errors import InvalidProblem
-from lawbench.problem import Contact, ImpactProblem
+from lawbench.problem import Contact, ImpactProblem, is_sparse
 
 FORMAT, VERSION = "lawbench-problem", 1
 MATRICES = ("M", "Wn", "Wt", "v", "gaps")
@@ -52,7 +54,7 @@ def to_dict(problem: ImpactProblem) -> dict[str, Any]:
     for name in MATRICES:
         value = getattr(problem, name)
         if value is not None:
-            data[name] = np.array(value)
+            data[name] = value if is_sparse(value) else np.array(value)
     data["bodies"] = {name: list(idx) for name, idx in problem.bodies.items()}
     data["contacts"] = [{f: getattr(c, f) for f in CONTACT_FIELDS} for c in problem.contacts]
     return data
@@ -151,6 +153,8 @@ def load_problem(path: str | Path) -> ImpactProblem:
 
 
 def _json_default(value: Any) -> Any:
+    if is_sparse(value):
+        value = value.toarray()
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
@@ -177,18 +181,23 @@ def _reject_constant(name: str) -> float:
 
 
 def _arrays(data: dict[str, Any]) -> dict[str, np.ndarray]:
-    """Flat arrays for NPZ and HDF5: dense, or CSR triplets for mostly-zero matrices."""
+    """Flat arrays for NPZ and HDF5: dense, or CSR triplets for mostly-zero matrices.
+
+    ``sparse`` marks a problem given with scipy.sparse matrices, read back as one.
+    """
     arrays: dict[str, np.ndarray] = {
         "format": np.array(FORMAT),
         "version": np.array(VERSION),
         "bodies": np.array(json.dumps(data["bodies"])),
         "contacts": np.array(json.dumps(data["contacts"])),
     }
+    if is_sparse(data["M"]):
+        arrays["sparse"] = np.array(True)
     for name in MATRICES:
         if name not in data:
             continue
         value = data[name]
-        if (
+        if is_sparse(value) or (
             value.ndim == 2
             and value.size > 64
             and np.count_nonzero(value) <= SPARSE_SHARE * value.size
@@ -216,14 +225,16 @@ def _from_arrays(get: Callable[[str], Any], names: set[str]) -> dict[str, Any]:
         if key in names:
             text = np.asarray(get(key)).item()
             data[key] = json.loads(text.decode() if isinstance(text, bytes) else text)
+    sparse = "sparse" in names and bool(np.asarray(get("sparse")))
     for name in MATRICES:
         if name in names:
             data[name] = np.asarray(get(name))
         elif f"{name}.data" in names:
             shape = tuple(int(s) for s in np.asarray(get(f"{name}.shape")))
-            data[name] = scipy.sparse.csr_matrix(
+            matrix = scipy.sparse.csr_matrix(
                 (get(f"{name}.data"), get(f"{name}.indices"), get(f"{name}.indptr")), shape
-            ).toarray()
+            )
+            data[name] = matrix if sparse else matrix.toarray()
     return data
 
 

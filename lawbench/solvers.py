@@ -32,7 +32,7 @@ import scipy.sparse.linalg
 from lawbench import budget
 from lawbench.errors import SolverFailure
 from lawbench.mechanics import is_diagonal
-from lawbench.problem import SPARSE_SHARE
+from lawbench.problem import SPARSE_SHARE, as_array, is_sparse
 
 ROUNDING = 1e-12
 # Contacts up to which active-set enumeration (2**m sets) is the exact, cheap method.
@@ -69,12 +69,17 @@ def clarabel_qp(
 ) -> QPResult:
     """Solve ``min x.P x / 2 + c.x`` subject to ``A x >= 0`` with clarabel.
 
+    ``P`` and ``A`` are numpy or scipy.sparse arrays; sparse ones reach clarabel as they are.
     Returns whatever clarabel ended with; the caller decides whether its status will do.
     """
+    if is_sparse(P):
+        upper, constraints = scipy.sparse.triu(P, format="csc"), (-A).tocsc()
+    else:
+        upper, constraints = scipy.sparse.csc_matrix(np.triu(P)), scipy.sparse.csc_matrix(-A)
     solver = clarabel.DefaultSolver(
-        scipy.sparse.csc_matrix(np.triu(P)),
+        upper,
         np.asarray(c, dtype=float),
-        scipy.sparse.csc_matrix(-A),
+        constraints,
         np.zeros(A.shape[0]),
         [clarabel.NonnegativeConeT(A.shape[0])],
         clarabel_settings(tol, max_iter),
@@ -116,14 +121,17 @@ def polish(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> np.ndarray | None:
 def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarray | None:
     exact = np.zeros_like(q)
     if active.any():
+        rows = np.flatnonzero(active)
         try:
-            exact[active] = _solve_block(G[np.ix_(active, active)], -q[active])
+            exact[active] = _solve_block(G[np.ix_(rows, rows)], -q[active])
         except (np.linalg.LinAlgError, ValueError):
             return None
     slack = G @ exact + q
     velocity_scale = max(np.abs(q).max(), ROUNDING)
     impulse_scale = max(np.abs(exact).max(), ROUNDING)
-    if exact.min() < -1e-10 * impulse_scale or slack.min() < -1e-10 * velocity_scale:
+    # A slack is a sum of terms G_ij z_j that cancel down to the size of q: their rounding too.
+    rounding = ROUNDING * (abs(G) @ np.abs(exact))
+    if exact.min() < -1e-10 * impulse_scale or (slack < -1e-10 * velocity_scale - rounding).any():
         return None
     return np.maximum(exact, 0.0)
 
@@ -131,11 +139,14 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
 def _solve_block(block: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Solve a symmetric positive (semi)definite block of a Delassus matrix.
 
-    Sparse LU when it is large and sparse (the banded blocks of chains), a dense solve otherwise.
+    Sparse LU when it is sparse, or large with few non-zero entries (the banded blocks of
+    chains), a dense solve otherwise.
 
     An ill-conditioned block (redundant contacts) is fine: the caller checks the answer.
     """
-    if block.shape[0] > SPARSE_SIZE and np.count_nonzero(block) <= SPARSE_SHARE * block.size:
+    if is_sparse(block) or (
+        block.shape[0] > SPARSE_SIZE and np.count_nonzero(block) <= SPARSE_SHARE * block.size
+    ):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", scipy.sparse.linalg.MatrixRankWarning)
             solution = scipy.sparse.linalg.spsolve(scipy.sparse.csc_matrix(block), rhs)
@@ -343,7 +354,7 @@ def solve_lcp(
 
     Parameters
     ----------
-    G : array (m, m)
+    G : array or scipy.sparse array (m, m)
         Symmetric positive semidefinite matrix.
     q : array (m,)
         Constant term.
@@ -356,19 +367,20 @@ def solve_lcp(
         enumeration finds no set, a numerically singular problem).
     """
     if is_diagonal(G):
-        diagonal = np.diag(G)
+        diagonal = G.diagonal()
         if (diagonal <= 0).any():
             raise SolverFailure("the LCP matrix has a zero diagonal entry")
         z = np.maximum(-q / diagonal, 0.0)
         method = "closed form" if len(q) == 1 else "decoupled (diagonal Delassus)"
         return LCPResult(z, G @ z + q, method)
     if len(q) <= ENUMERATION_MAX:
-        solved = _enumerate_one(G, q)
+        solved = _enumerate_one(as_array(G), q)
         if solved is not None:
             return LCPResult(*solved, "LCP (active-set enumeration)")
     if method == "nnls":
-        return _nnls_lcp(G, q)
-    result = clarabel_qp(G, q, np.eye(len(q)), tol)
+        return _nnls_lcp(as_array(G), q)
+    identity = scipy.sparse.identity(len(q), format="csc") if is_sparse(G) else np.eye(len(q))
+    result = clarabel_qp(G, q, identity, tol)
     return _finish(G, q, result.x, result, refine)
 
 

@@ -47,7 +47,9 @@ clarabel) for one coefficient when no closed contact separates, or the LCP in th
 QP in ``Pn >= 0``, solved with clarabel) otherwise. With friction, the second-order cone QP in
 the impulses ``min P.G P / 2 + (q + s).P`` over the cones ``K_j`` (``G`` the contact Delassus
 matrix, ``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clarabel
-(`lawbench.cones`); option ``friction``:
+(`lawbench.cones`). A sparse problem (`ImpactProblem.sparse`, long chains) stays sparse on the
+frictionless path, from the Delassus matrix to clarabel and the polish's block solve, so a
+chain costs time linear in its length; with friction it is solved dense. Option ``friction``:
 
 - ``coulomb`` (default, "SOCP fixed point (clarabel)"): the exact law. Starting from
   ``s = 0``, each step fixes ``s_j = mu_j |ut+_j|`` from the previous solution and solves the
@@ -119,6 +121,7 @@ class Moreau(Law):
         "2011; Anitescu 2006"
     )
     tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="tol")
+    takes_sparse = True
 
     def rule_for_separating(self, options: dict[str, Any]) -> str:
         """The rule of option ``separating``."""
@@ -204,7 +207,7 @@ class Moreau(Law):
         else:
             restituted = un
         if problem.frictional:
-            return _resolve_friction(problem, e * restituted, options)
+            return _resolve_friction(problem.dense(), e * restituted, options)
         large = problem.m > ENUMERATION_MAX
         single_e = large and len(set(e)) == 1 and np.array_equal(restituted, un)
         if single_e and large and not is_diagonal(problem.delassus):
