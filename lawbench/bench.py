@@ -35,6 +35,12 @@ from lawbench.solvers import clarabel_settings, enumerate_lcp
 CHAINS = (100, 1000, 10_000)
 
 
+# Chain sizes and options of the integrating laws: lzb at the tolerance that keeps the energy
+# of a 1000-ball chain to 1e-9.
+INTEGRATING = {"lzb": ((100, 1000), {"tol": 1e-12}), "compliant": ((100, 300), {})}
+QUICK_INTEGRATING = {"lzb": ((30, 60), {"tol": 1e-12}), "compliant": ((20, 40), {})}
+
+
 def median_time(function: Callable[[], Any], repeats: int, number: int = 1) -> float:
     """Median over ``repeats`` of the mean wall time of ``number`` calls, in seconds."""
     times = []
@@ -217,6 +223,34 @@ def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) ->
     return lines
 
 
+def integrating_chains(runs: dict[str, tuple[tuple[int, ...], dict[str, Any]]]) -> list[str]:
+    """The laws that integrate, once each on elastic n-ball chains (one ball strikes the rest).
+
+    ``runs`` maps a law to its chain sizes and options. Each line gives the time, the relative
+    energy error ``|T+ - T-| / T-`` (the exact answer keeps the energy), the integrator's steps
+    and contact events, and the last the growth exponent of the time.
+    """
+    from lawbench.api import solve
+
+    lines = ["integrating laws on an elastic n-ball chain (ball_chain, e = 1), one run each:"]
+    for law, (sizes, options) in runs.items():
+        times = []
+        for balls in sizes:
+            start = time.perf_counter()
+            outcome = solve(law, "ball_chain", {**options, "max_seconds": 3600.0}, n=balls, e=[1.0])
+            times.append(time.perf_counter() - start)
+            error = abs(outcome.T_plus - outcome.T_minus) / outcome.T_minus
+            given = "".join(f", {k} = {v:g}" for k, v in options.items())
+            lines.append(
+                f"  {law}, n = {balls}{given}".ljust(48)
+                + f"{_time(times[-1]):>12}   energy error {error:.2g}, "
+                f"{outcome.diagnostics['steps']} steps, {outcome.diagnostics['events']} events"
+            )
+        growth = np.log(times[-1] / times[0]) / np.log(sizes[-1] / sizes[0])
+        lines.append(f"  {law}: time grows like n^{growth:.2f} from n = {sizes[0]} to {sizes[-1]}")
+    return lines
+
+
 def start_up(repeats: int) -> list[str]:
     """Whole-process time of a Newton solve against importing numpy alone."""
     solve = [sys.executable, "-m", "lawbench", "solve", "newton", "three_ball_chain"]
@@ -243,6 +277,7 @@ def report(quick: bool = False) -> str:
         *small_impact(repeats),
         *batch_of_impacts(10_000 if quick else 100_000, repeats),
         *(long_chains((100, 1000), repeats) if quick else long_chains(CHAINS, repeats, 1000)),
+        *integrating_chains(QUICK_INTEGRATING if quick else INTEGRATING),
         *start_up(repeats),
     ]
     return "\n".join(lines)
