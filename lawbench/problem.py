@@ -83,6 +83,8 @@ def is_sparse(value: object) -> bool:
 
     Without scipy.sparse imported no value can be one, so small problems never import it.
     """
+    if isinstance(value, np.ndarray):
+        return False
     module = sys.modules.get("scipy.sparse")
     return module is not None and bool(module.issparse(value))
 
