@@ -7,7 +7,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from lawbench.problem import (
-    SMALL,
     SPARSE_SHARE,
     ImpactProblem,
     as_array,
@@ -17,6 +16,10 @@ from lawbench.problem import (
 
 if TYPE_CHECKING:
     import scipy.sparse
+
+# Rows beyond which a CSR product (about 3 us, mostly its dispatch) beats a dense one on a
+# banded matrix.
+SPARSE_PRODUCTS = 200
 
 
 def generalized_impulse(
@@ -79,14 +82,15 @@ def energy_shares(problem: ImpactProblem, v: np.ndarray) -> dict[str, float]:
 def for_products(A: np.ndarray) -> np.ndarray | scipy.sparse.csr_matrix:
     """``A`` in the form its matrix-vector products are cheapest in.
 
-    A large matrix that is mostly zeros (a chain's Jacobian or Delassus matrix: banded) as a
-    CSR matrix, whose products cost O(nnz) instead of O(rows x columns); any other as given.
+    A matrix of more than ``SPARSE_PRODUCTS`` rows that is mostly zeros (a chain's Jacobian
+    or Delassus matrix: banded) as a CSR matrix, whose products cost O(nnz) instead of
+    O(rows x columns); any other as given.
     The integrating laws evaluate such products at every stage of every step.
     """
     import scipy.sparse  # on first use: a closed-form law imports no sparse algebra
 
     if scipy.sparse.issparse(A):
         return scipy.sparse.csr_matrix(A)
-    if A.shape[0] > SMALL and np.count_nonzero(A) <= SPARSE_SHARE * A.size:
+    if A.shape[0] > SPARSE_PRODUCTS and np.count_nonzero(A) <= SPARSE_SHARE * A.size:
         return scipy.sparse.csr_matrix(A)
     return A

@@ -174,7 +174,6 @@ class _Integration:
         )
         self.e = problem.restitution("newton")
         self.given_damping = np.array([c.damping for c in contacts])
-        self.B = for_products(problem.solve_mass(problem.Wn))
         self.WnT = for_products(problem.Wn.T)
         G = np.diag(problem.delassus)
         self.V = float(max(np.abs(problem.un).max(), 1e-300))
@@ -182,6 +181,8 @@ class _Integration:
         self.L = float(indentation.min())
         self.tau = self.L / self.V
         self.I = self.V / float(G.max())
+        # Scaled velocity change per newton of each contact force: (tau / V) M^-1 Wn.
+        self.B = for_products((self.tau / self.V) * problem.solve_mass(problem.Wn))
         self.clipped = not (self.model == "kelvin_voigt" and options["termination"] == "gap")
         self.c = self._initial_damping(G)
 
@@ -209,17 +210,17 @@ class _Integration:
     # Forces, in newtons, from physical gaps and gap rates.
     def forces(self, g: np.ndarray, un: np.ndarray) -> np.ndarray:
         d, rate = -g, -un
-        positive = d > 0
-        dn = np.where(positive, np.abs(d) ** self.n, 0.0)
         if self.model == "kelvin_voigt":
-            law = self.k * d + self.c * rate
-        elif self.model == "hertz":
-            law = self.k * dn + self.c * np.where(positive, np.abs(d) ** (self.n - 1), 0.0) * rate
+            law = np.where(d > 0, self.k * d + self.c * rate, 0.0)
         else:
-            law = self.k * dn * (1.0 + self.c * rate)
-        if self.clipped:
-            law = np.maximum(law, 0.0)
-        return np.where(positive, law, 0.0)
+            # Zero where the contact is open (0^n = 0): the powers need no mask.
+            dn = np.maximum(d, 0.0) ** self.n
+            if self.model == "hertz":
+                damper = np.where(d > 0, np.abs(d) ** (self.n - 1), 0.0)
+                law = self.k * dn + self.c * damper * rate
+            else:
+                law = self.k * dn * (1.0 + self.c * rate)
+        return np.maximum(law, 0.0) if self.clipped else law
 
     def switches(self, g: np.ndarray, un: np.ndarray) -> np.ndarray:
         """Functions whose zeros are the branch changes: the gaps, and the dashpot signs."""
@@ -240,9 +241,7 @@ class _Integration:
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         g, _, un = self.physical(y)
         F = self.forces(g, un)
-        return np.concatenate(
-            [un / self.V, (self.tau / self.V) * (self.B @ F), (self.tau / self.I) * F]
-        )
+        return np.concatenate([un / self.V, self.B @ F, (self.tau / self.I) * F])
 
     def ended(self, y: np.ndarray) -> bool:
         g, _, un = self.physical(y)
