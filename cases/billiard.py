@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.case import CASES, Case, Params, Reference, per_item
+from lawbench.chains import exponent_spec, stiffness_ratio_spec
 from lawbench.checks import Trial
 from lawbench.errors import InvalidProblem
 from lawbench.problem import Contact, ImpactProblem
@@ -111,16 +112,8 @@ class Billiard(Case):
         ),
         Spec("e", [0.8, 0.5], "restitution, cue-ball then ball-table", "", "floats", 0.0, 1.0),
         Spec("mu", [0.6, 0.2], "friction, cue-ball then ball-table", "", "floats", 0.0),
-        Spec(
-            "stiffness_ratio",
-            1.0,
-            "stiffness of the ball-table contact over the cue-ball one",
-            "",
-            "float",
-            0.0,
-            low_open=True,
-        ),
-        Spec("exponent", 1.5, "force-indentation exponent", "", "float", 0.0, low_open=True),
+        stiffness_ratio_spec("stiffness of the ball-table contact over the cue-ball one"),
+        exponent_spec(),
     )
     requires = Tags(friction=True, several_contacts=True, spatial=True)
     references = (

@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.case import CASES, Case, GroundTruth, Params, per_item
+from lawbench.chains import exponent_spec, stiffness_ratio_spec
 from lawbench.errors import InvalidProblem
 from lawbench.problem import Contact, ImpactProblem
 from lawbench.spec import Spec
@@ -120,24 +121,8 @@ class DiskBall(Case):
             0.0,
             1.0,
         ),
-        Spec(
-            "stiffness_ratio",
-            1.0,
-            "stiffness of each floor point over that of the ball contact",
-            "",
-            "float",
-            0.0,
-            low_open=True,
-        ),
-        Spec(
-            "exponent",
-            1.5,
-            "force-indentation exponent (1.5 Hertz)",
-            "",
-            "float",
-            0.0,
-            low_open=True,
-        ),
+        stiffness_ratio_spec("stiffness of each floor point over that of the ball contact"),
+        exponent_spec(),
     )
     requires = Tags(friction=True, several_contacts=True)
     ground_truth = GroundTruth(

@@ -52,6 +52,7 @@ from lawbench.chains import (
     exponent_spec,
     gaps_spec,
     masses_spec,
+    stiffness_ratio_spec,
     velocities_spec,
 )
 from lawbench.spec import Spec
@@ -86,14 +87,9 @@ class PingPong(TwoBallsWall):
             0.0,
             1.0,
         ),
-        Spec(
-            "stiffness_ratio",
-            GUESSED_RATIO,
-            "stiffness of the table contact over the ball contact, k2/k1",
-            "",
-            "float",
-            0.0,
-            low_open=True,
+        dataclasses.replace(
+            stiffness_ratio_spec("stiffness of the table contact over the ball contact, k2/k1"),
+            default=GUESSED_RATIO,
         ),
         # The source's model has linear springs.
         dataclasses.replace(exponent_spec(), default=1.0),
