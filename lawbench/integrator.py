@@ -35,7 +35,8 @@ class Event:
     """Where the integration stopped: just past the sign change of the ``fired`` functions.
 
     ``fired`` lists the event functions whose change lies within the integrator's
-    ``simultaneous`` distance of ``x``, the first one first.
+    ``simultaneous`` distance of ``x``, the first one first; it is empty when the integration
+    reached its end ``x_end`` without an event.
     """
 
     x: float
@@ -92,8 +93,8 @@ class EventIntegrator:
         x_end: float = np.inf,
         jac: Callable | None = None,
         on_step: Callable[[Dense, float, float], None] | None = None,
-    ) -> Event | None:
-        """Integrate from ``(x0, y0)`` to just past the first event, or None at ``x_end``.
+    ) -> Event:
+        """Integrate from ``(x0, y0)`` to just past the first event, or to ``x_end``.
 
         Parameters
         ----------
@@ -145,7 +146,7 @@ class EventIntegrator:
                 before, start = after, x
             if on_step is not None:
                 on_step(dense, solver.t_old, solver.t)
-        return None
+        return Event(float(solver.t), solver.y, ())
 
     def _locate(
         self,

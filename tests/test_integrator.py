@@ -56,8 +56,8 @@ def test_the_first_of_several_events_and_those_simultaneous_with_it():
     assert both.fired == (1, 0)
 
 
-def test_no_event_before_the_end_returns_none_and_every_step_is_seen():
-    """No event before x_end; the steps seen are contiguous from the start to the end."""
+def test_no_event_before_the_end_returns_the_end_and_every_step_is_seen():
+    """No event before x_end: the state there, nothing fired; the steps seen are contiguous."""
     seen = []
     event = EventIntegrator().to_event(
         harmonic,
@@ -67,7 +67,8 @@ def test_no_event_before_the_end_returns_none_and_every_step_is_seen():
         x_end=10.0,
         on_step=lambda dense, t_old, t: seen.append((t_old, t)),
     )
-    assert event is None
+    assert event.fired == () and event.x == 10.0
+    np.testing.assert_allclose(event.y, [np.sin(10.0), np.cos(10.0)], rtol=1e-6)
     assert seen[0][0] == 0.0 and seen[-1][1] == 10.0
     assert all(a[1] == b[0] for a, b in itertools.pairwise(seen))
 

@@ -297,7 +297,7 @@ class SingleContactImpact:
             u = self.u_minus + np.outer(P, self.G[:, 0]) + Pt @ self.G[:, 1:].T
             self.record.sample(P, Pt, u, W)
             state = State(float(P[-1]), Pt[-1], u[-1], float(W[-1]))
-            if event is None or event.fired[0] == BOUND:
+            if not event.fired or event.fired[0] == BOUND:
                 raise SolverFailure(
                     f"darboux_keller: slip goes on past {IMPULSE_BOUND:g} times the "
                     "frictionless compression impulse"

@@ -301,7 +301,7 @@ class SpringImpact:
                 x_end=tau + PERIODS * self.time_scale,
                 on_step=self._on_step,
             )
-            if event is None:
+            if not event.fired:
                 raise SolverFailure(
                     f"jia: no contact event within {PERIODS:g} natural periods: the impact "
                     "does not end"
