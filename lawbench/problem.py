@@ -8,6 +8,7 @@ Sign conventions, used everywhere in lawbench: the gap rate of contact j is
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
@@ -141,7 +142,12 @@ class Contact:
     tangential_stiffness_ratio: float | None = None
 
     def validate(self, label: str) -> None:
-        """Raise `InvalidProblem` naming ``label.field`` for the first bad field."""
+        """Raise `InvalidProblem` naming ``label.field`` for the first bad field.
+
+        A contact is immutable: once it has passed, it is not checked again.
+        """
+        if "_valid" in self.__dict__:
+            return
         for name in ("e", "e_newton", "e_poisson", "e_energy"):
             value = getattr(self, name)
             if value is not None:
@@ -156,6 +162,7 @@ class Contact:
             _check_range(f"{label}.{name}", value, 0.0)
             if value == 0.0:
                 raise InvalidProblem(f"{label}.{name} = 0: must be > 0")
+        object.__setattr__(self, "_valid", True)
 
     def restitution(self, kind: str) -> float:
         """Return the coefficient of ``kind`` ('newton', 'poisson' or 'energy')."""
@@ -166,6 +173,15 @@ class Contact:
 
 
 CONTACT_FIELDS = frozenset(f.name for f in dataclasses.fields(Contact))
+
+
+@functools.lru_cache(maxsize=256)
+def _shared_contact(coefficients: tuple[tuple[str, type, object], ...]) -> Contact:
+    """The one contact of coefficients every contact shares: built (and checked) once.
+
+    Each value comes with its type, so that 1 and 1.0, equal as keys, build their own contact.
+    """
+    return Contact(**{name: value for name, _, value in coefficients})
 
 
 def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray:
@@ -397,7 +413,8 @@ class ImpactProblem:
             ]
         else:
             # One set of coefficients: one (immutable) contact serves, validated once.
-            contacts = [Contact(**shared)] * m
+            key = tuple(sorted((name, type(value), value) for name, value in shared.items()))
+            contacts = [_shared_contact(key)] * m
         return cls(M, Wn, v, contacts, Wt, dict(bodies or {}), gaps)
 
     def _factor_mass(self) -> float:

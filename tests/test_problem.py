@@ -158,3 +158,18 @@ def test_a_long_plastic_chain_sticks_at_the_momentum_average():
     outcome = lawbench.solve("moreau", "ball_chain", n=500, e=0.0)
     assert outcome.diagnostics["polished"]
     np.testing.assert_allclose(outcome.v_plus, np.full(500, 1 / 500), atol=1e-12)
+
+
+def test_shared_coefficients_build_one_checked_contact_of_the_type_given():
+    """Coefficients every contact shares build one contact, reused across problems; the value
+    keeps the type it was given (1 and 1.0 are equal keys), and a bad one is refused each time.
+    """
+    M, Wn, v = np.eye(2), [[-1.0], [1.0]], [1.0, 0.0]
+    first = ImpactProblem.from_arrays(M, Wn, v, e=1).contacts[0]
+    again = ImpactProblem.from_arrays(M, Wn, v, e=1).contacts[0]
+    as_float = ImpactProblem.from_arrays(M, Wn, v, e=1.0).contacts[0]
+    assert first is again
+    assert type(first.e) is int and type(as_float.e) is float
+    for _ in range(2):
+        with pytest.raises(InvalidProblem, match=r"contacts\[0\]\.e = 1\.5"):
+            ImpactProblem.from_arrays(M, Wn, v, e=1.5)
