@@ -97,6 +97,7 @@ class Segment:
         self.offset = np.where(self.phase == IDLE, self.rest, 0.0)
         self.expanding = self.phase == EXPANSION
         self.loaded = self.phase != IDLE
+        self.acting = np.flatnonzero(self.loaded)
 
 
 class EnergeticImpact:
@@ -181,12 +182,25 @@ class EnergeticImpact:
         return self.u0 + w[:m], self.ut0 + w[m:]
 
     def energies(self, y: np.ndarray) -> np.ndarray:
-        """Scaled stored energies ``k s^(eta+1) / (eta+1)``."""
-        return self.k_energy * np.maximum(y[self.iS], 0.0) ** (self.eta + 1)
+        """Scaled stored energies ``k s^(eta+1) / (eta+1)``.
+
+        The powers are taken where a spring is compressed (a wave loads a few contacts of a
+        long chain at a time); every other energy is zero.
+        """
+        s = y[self.iS]
+        j = np.flatnonzero(s > 0.0)
+        E = np.zeros(self.m)
+        E[j] = self.k_energy[j] * s[j] ** (self.eta[j] + 1)
+        return E
 
     def forces(self, y: np.ndarray, seg: Segment) -> tuple[np.ndarray, np.ndarray]:
-        """Scaled normal and tangential forces at ``y`` in segment ``seg``."""
-        Fn = np.where(seg.loaded, self.k * np.maximum(y[self.iS], 0.0) ** self.eta, 0.0)
+        """Scaled normal and tangential forces at ``y`` in segment ``seg``.
+
+        Only the loaded contacts carry a force: the powers are taken there alone.
+        """
+        j = seg.acting
+        Fn = np.zeros(self.m)
+        Fn[j] = self.k[j] * np.maximum(y[self.iS][j], 0.0) ** self.eta[j]
         if not self.friction:
             return Fn, np.zeros(0)
         Ft = -self.mu * Fn * seg.slip
