@@ -7,7 +7,6 @@ identifies a law's coefficients from measured pre- and post-impact velocities.
 """
 
 import importlib
-import importlib.metadata
 
 from lawbench.api import evaluate, solve, solve_batch
 from lawbench.batch import OutcomeBatch, ProblemBatch
@@ -27,8 +26,6 @@ from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim, Region, Verdict
 
-__version__ = importlib.metadata.version("lawbench")
-
 # Loaded when first asked for: problem files need scipy.sparse (and h5py for HDF5), fitting
 # needs pandas and scipy.optimize, run tables pandas and pyarrow, figures matplotlib.
 _LAZY = {
@@ -44,6 +41,12 @@ _LAZY = {
 
 
 def __getattr__(name: str) -> object:
+    if name == "__version__":
+        # The installed distribution's version, read when asked: importlib.metadata costs a
+        # third of the start-up of a small command.
+        from importlib.metadata import version
+
+        return version("lawbench")
     if name in _LAZY:
         return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'lawbench' has no attribute {name!r}")

@@ -16,7 +16,6 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from lawbench import __version__
 from lawbench.api import evaluate
 from lawbench.case import CASES, Case
 from lawbench.checks import run_checks
@@ -57,6 +56,19 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:
         self.exit(2, f"lawbench: {message} (see lawbench --help)\n")
+
+
+class _Version(argparse.Action):
+    """``--version``: the installed version, looked up only when asked for."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: object) -> None:
+        import lawbench
+
+        print(f"lawbench {lawbench.__version__}")
+        parser.exit()
 
 
 def _assignments(items: Sequence[str], flag: str) -> dict[str, str]:
@@ -416,7 +428,7 @@ def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lawbench`` command."""
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
-    parser.add_argument("--version", action="version", version=f"lawbench {__version__}")
+    parser.add_argument("--version", action=_Version, help="print the version and exit")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     commands.add_parser("list", help="list the laws and cases").set_defaults(run=_list)
     describe = commands.add_parser("describe", help="describe a law or a case")

@@ -15,7 +15,6 @@ breaking the others.
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 import importlib.util
 import inspect
 import pkgutil
@@ -23,6 +22,17 @@ from collections.abc import Iterator
 from typing import Generic, Protocol, TypeVar
 
 from lawbench.errors import InvalidProblem
+
+
+def _entry_points(**selection: str) -> list:
+    """The installed entry points selected (``group``, ``name``).
+
+    importlib.metadata is imported here, on first use: it costs a third of the start-up of a
+    command that solves one built-in law on one built-in scene.
+    """
+    import importlib.metadata
+
+    return list(importlib.metadata.entry_points(**selection))
 
 
 class _Named(Protocol):
@@ -69,7 +79,7 @@ class Registry(Generic[Entry]):
                 importlib.import_module(f"{self.package}.{module.name}")
             except ImportError as exc:
                 self.unavailable[module.name] = f"missing dependency: {exc}"
-        for point in importlib.metadata.entry_points(group=self.package):
+        for point in _entry_points(group=self.package):
             try:
                 self._plug(point.load())
             except Exception as exc:  # a broken plugin is reported, the others still load
@@ -86,7 +96,7 @@ class Registry(Generic[Entry]):
                 return
         except ImportError:
             return  # the full load records why
-        for point in importlib.metadata.entry_points(group=self.package, name=name):
+        for point in _entry_points(group=self.package, name=name):
             try:
                 self._plug(point.load())
             except Exception:  # the full load records why

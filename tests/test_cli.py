@@ -446,3 +446,18 @@ def test_small_commands_import_no_heavy_library(argv):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+def test_a_solve_of_built_in_entries_reads_no_installed_metadata():
+    """A built-in law on a built-in scene needs no plugin lookup and no version: the package
+    metadata (a third of the start-up) is read only for ``list``, plugins and ``--version``."""
+    code = (
+        "import contextlib, io, sys\n"
+        "from lawbench.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    main(['solve', 'newton', 'three_ball_chain'])\n"
+        "print('importlib.metadata' in sys.modules)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"
