@@ -16,7 +16,6 @@ Two forms, one rule: a job that has not answered after its budget is stopped and
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import signal
 import threading
@@ -26,10 +25,13 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from multiprocessing.connection import Connection, wait
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from lawbench.errors import BudgetExceeded
+
+if TYPE_CHECKING:
+    import multiprocessing.process
+    from multiprocessing.connection import Connection
 
 TIME_OUT = "time-out"
 WARNINGS_KEPT = 10
@@ -84,6 +86,9 @@ class Result:
 
 def _end_with_parent() -> None:
     """End this worker as soon as the process that started it ends, even when killed."""
+    import multiprocessing
+    from multiprocessing.connection import wait
+
     parent = multiprocessing.parent_process()
     if parent is None:
         return
@@ -153,6 +158,9 @@ class Guard:
     def __init__(self, workers: int, budget_s: float) -> None:
         self.workers, self.budget_s = max(1, workers), budget_s
         # Spawned workers start clean: no thread or solver state copied from the parent.
+        # multiprocessing loads here: a solve guarded in this process needs `alarm` alone.
+        import multiprocessing
+
         self._context = multiprocessing.get_context("spawn")
         self._pool: list[_Worker] = []
         self._queue: deque[_Task] = deque()
@@ -218,6 +226,8 @@ class Guard:
 
     def _step(self) -> None:
         """Hand out queued tasks, then wait for one answer or one deadline."""
+        from multiprocessing.connection import wait
+
         while len(self._pool) < self.workers:
             self._pool.append(self._start())
         for worker in self._pool:
