@@ -270,6 +270,17 @@ def test_chain_energy_balance(seed):
     assert outcome.Pn.min() >= 0
 
 
+def test_a_long_elastic_chain_keeps_energy_and_momentum_with_banded_products():
+    """A 250-ball elastic chain, its Delassus matrix multiplied as a sparse, banded one: the
+    springs keep the energy (to the tolerance) and the momentum, and no contact approaches."""
+    params = {"n": 250, "e": 1.0, "velocities": [1.0]}
+    outcome = lawbench.solve("jia", "ball_chain", **params)
+    problem = lawbench.CASES.get("ball_chain").build(**params)
+    assert abs(outcome.dT) <= 1e-9 * outcome.T_minus
+    assert abs(problem.M.diagonal() @ (outcome.v_plus - problem.v)) <= 1e-10
+    assert (problem.Wn.T @ outcome.v_plus).min() >= -1e-8 * np.abs(problem.un).max()
+
+
 # --- invariants on random problems --------------------------------------------------------------
 
 
