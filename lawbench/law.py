@@ -209,9 +209,12 @@ class Law(ABC):
 
 def _refuse_non_finite(name: str, outcome: Outcome) -> None:
     """Raise `SolverFailure` naming the first field of ``outcome`` with a non-finite number."""
-    # One finite sum proves every number finite; only otherwise is each field looked at.
-    total = outcome.v_plus.sum() + outcome.Pn.sum() + outcome.T_plus
-    if math.isfinite(total + outcome.Pt.sum() if outcome.Pt.size else total):
+    if (
+        math.isfinite(outcome.T_plus)
+        and all_finite(outcome.v_plus)
+        and all_finite(outcome.Pn)
+        and all_finite(outcome.Pt)
+    ):
         return
     for field in ("v_plus", "Pn", "Pt", "T_plus"):
         if not all_finite(np.asarray(getattr(outcome, field))):

@@ -66,13 +66,19 @@ def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
     return float(v @ M @ v) / 2.0
 
 
+# Up to this many entries an array is summed as Python floats: cheaper than a numpy reduction.
+SUMMED_IN_PYTHON = 64
+
+
 def all_finite(array: np.ndarray) -> bool:
     """Whether every entry of ``array`` is finite.
 
     An infinite or NaN entry makes the sum non-finite, so a finite sum settles it in one
-    reduction; only a non-finite sum (which overflow can also give) is looked at entry by entry.
+    reduction (of Python floats for a small array: overflow and NaN propagate there without a
+    warning); only a non-finite sum (which overflow can also give) is looked at entry by entry.
     """
-    return math.isfinite(array.sum()) or bool(np.isfinite(array).all())
+    total = sum(array.ravel().tolist()) if array.size <= SUMMED_IN_PYTHON else array.sum()
+    return math.isfinite(total) or bool(np.isfinite(array).all())
 
 
 # Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
