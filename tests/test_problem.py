@@ -173,3 +173,25 @@ def test_shared_coefficients_build_one_checked_contact_of_the_type_given():
     for _ in range(2):
         with pytest.raises(InvalidProblem, match=r"contacts\[0\]\.e = 1\.5"):
             ImpactProblem.from_arrays(M, Wn, v, e=1.5)
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("v_plus", np.array([np.nan, 0.0])), ("Pn", np.array([np.inf])), ("Pt", np.array([np.nan]))],
+)
+def test_a_law_never_returns_a_non_finite_answer(field, value):
+    """The law protocol refuses a non-finite field of an outcome by name, whatever the law."""
+
+    class Broken(lawbench.Law):
+        name = "broken"
+        summary = "returns a non-finite field"
+        source = "none: a test of the protocol"
+        tags = lawbench.Tags()
+
+        def _resolve(self, problem, options):
+            outcome = lawbench.Outcome.from_impulses(problem, np.zeros(1))
+            return dataclasses.replace(outcome, **{field: value})
+
+    problem = ImpactProblem.from_arrays(np.eye(2), [[-1.0], [1.0]], [1.0, 0.0])
+    with pytest.raises(lawbench.SolverFailure, match=f"non-finite {field}"):
+        Broken().resolve(problem)
