@@ -209,7 +209,6 @@ class _Integration:
         self.I = self.V / float(diagonal.max())
         # Scaled Delassus matrix: the scaled gap-rate change per scaled impulse.
         self.G = G / float(diagonal.max())
-        self.diagonal = diagonal
         self.clipped = not (self.model == "kelvin_voigt" and options["termination"] == "gap")
         self.c = self._initial_damping(diagonal)
         # The integrator resolves no speed below ``tol`` V (scaled: ``tol``): a contact that
