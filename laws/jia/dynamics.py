@@ -165,7 +165,10 @@ class SpringImpact:
         diag = np.diag(G)[: self.m] * self.kappa
         frequency = math.sqrt(float(diag.min()) / 2.0)
         self.time_scale = 2.0 * math.pi / frequency
-        impulse = float(np.abs(u_minus).max()) / float(np.diag(G)[: self.m].min())
+        # The impulse that stops the approach at the contact of the lightest effective mass
+        # (largest G_jj): the smallest impulse scale of the problem, so that the absolute
+        # tolerance resolves the impulses of a light body (a 1e-6 kg striker) as well.
+        impulse = float(np.abs(u_minus).max()) / float(np.diag(G)[: self.m].max())
         rate = float(np.abs(u_minus).max())
         self.scale = np.concatenate(
             [
