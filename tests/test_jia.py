@@ -280,6 +280,21 @@ def test_a_light_striker_keeps_the_energy_at_the_default_tolerance(striker):
     assert abs(outcome.dT) <= 1e-9 * outcome.T_minus
 
 
+@pytest.mark.parametrize("speed", [1e-4, 1e-6, 1e-8])
+def test_a_grazing_approach_under_a_fast_slip_keeps_the_friction_cone(speed):
+    """The falling rod's end slides at about 1 m/s while it approaches the floor at ``speed``:
+    the friction impulse stays within mu Pn, both of order ``speed`` times a mass. The
+    integrator's absolute tolerance follows the normal approach; with the slip speed's it left
+    |Pt| 1.7e-4 beyond the cone at 1e-8 m/s."""
+    from lawbench.transforms import apply
+
+    problem = apply(f"grazing={speed}", lawbench.CASES.get("falling_rod").build(e=1.0))
+    outcome = lawbench.LAWS.get("jia").resolve(problem)
+    Pt = np.abs(outcome.Pt).max()
+    assert Pt <= problem.mu[0] * outcome.Pn[0] * (1 + 1e-9)
+    assert outcome.Pn[0] > 0
+
+
 def test_a_long_elastic_chain_keeps_energy_and_momentum_with_banded_products():
     """A 250-ball elastic chain, its Delassus matrix multiplied as a sparse, banded one: the
     springs keep the energy (to the tolerance) and the momentum, and no contact approaches."""

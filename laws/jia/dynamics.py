@@ -165,15 +165,18 @@ class SpringImpact:
         diag = np.diag(G)[: self.m] * self.kappa
         frequency = math.sqrt(float(diag.min()) / 2.0)
         self.time_scale = 2.0 * math.pi / frequency
-        # The impulse that stops the approach at the contact of the lightest effective mass
-        # (largest G_jj): the smallest impulse scale of the problem, so that the absolute
-        # tolerance resolves the impulses of a light body (a 1e-6 kg striker) as well.
-        impulse = float(np.abs(u_minus).max()) / float(np.diag(G)[: self.m].max())
+        # The impulse that stops the fastest normal approach at the contact of the lightest
+        # effective mass (largest G_jj): the smallest impulse scale of the problem, so that the
+        # absolute tolerance resolves the impulses of a light body (a 1e-6 kg striker) and
+        # those of a grazing approach under a fast slip (the friction impulse is at most mu
+        # times the normal one), and the springs' states at that impulse.
+        approach = float(np.abs(u_minus[: self.m]).max())
+        impulse = approach / float(np.diag(G)[: self.m].max())
         rate = float(np.abs(u_minus).max())
         self.scale = np.concatenate(
             [
                 np.full(self.m, impulse),
-                np.full(self.m, math.sqrt(impulse * rate)),
+                np.full(self.m, math.sqrt(impulse * approach)),
                 np.full(self.d, impulse),
                 np.full(self.d, rate * self.time_scale),
             ]
