@@ -169,12 +169,6 @@ class Compliant(Law):
 LAWS.register(Compliant())
 
 
-def _ranges(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """The indices ``starts[i], ..., starts[i] + lengths[i] - 1`` of every i, in one array."""
-    ends = np.cumsum(lengths)
-    return np.arange(ends[-1] if ends.size else 0) + np.repeat(starts - ends + lengths, lengths)
-
-
 class _Integration:
     """One compliant impact in contact space: scaled gaps, gap rates and impulses.
 
@@ -318,18 +312,13 @@ class _Integration:
             "steps": self.steps,
             "events": events,
         }
-        Pn = self.I * P
-        v_plus = problem.v + problem.solve_mass(problem.Wn @ Pn)
         path = self._path() if options["path"] else None
-        return Outcome.from_velocity(problem, v_plus, Pn, diagnostics=diagnostics, path=path)
+        return Outcome.from_impulses(problem, self.I * P, diagnostics=diagnostics, path=path)
 
     def _neighbours(self, closed: np.ndarray) -> np.ndarray:
         """The contacts whose gap rate a closed contact's force changes (the closed included)."""
-        indptr = self.G.indptr
-        columns = np.flatnonzero(closed)
-        rows = self.G.indices[_ranges(indptr[columns], indptr[columns + 1] - indptr[columns])]
         near = closed.copy()
-        near[rows] = True
+        near[self.G[:, np.flatnonzero(closed)].indices] = True
         return near
 
     def _on_step(self, mode: _Mode, dense: Callable, t_old: float, t: float) -> None:
