@@ -22,7 +22,6 @@ import numpy as np
 from lawbench import budget
 from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
-from lawbench.mechanics import separating_contacts
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem, all_finite
 from lawbench.registry import Registry
@@ -121,12 +120,12 @@ class Law(ABC):
         reason = self.tags.refusal(problem)
         if reason:
             raise NotApplicable(f"{self.name}: {reason}")
-        separating = separating_contacts(problem)
+        separating = problem.separating
         rule = self.rule_for_separating(values) if separating else ""
         if separating and not rule:
             raise NotApplicable(
-                f"{self.name}: closed contacts {separating} separate before the impact, and the "
-                "law states no rule for them"
+                f"{self.name}: closed contacts {list(separating)} separate before the impact, "
+                "and the law states no rule for them"
             )
         if problem.sparse and not self.takes_sparse:
             problem = problem.dense()
@@ -148,7 +147,7 @@ class Law(ABC):
         _refuse_non_finite(self.name, outcome)
         outcome.diagnostics["options"] = values
         if separating:
-            outcome.diagnostics["separating_contacts"] = separating
+            outcome.diagnostics["separating_contacts"] = list(separating)
             outcome.diagnostics["separating_rule"] = rule
         outcome.diagnostics["wall_time_s"] = wall_time
         return outcome

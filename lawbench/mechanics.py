@@ -26,9 +26,9 @@ def generalized_impulse(
     problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
 ) -> np.ndarray:
     """Return the generalized impulse ``Wn @ Pn + Wt @ Pt`` (Pt None or empty: no friction)."""
-    impulse = problem.Wn @ Pn
+    impulse = problem.Wn.dot(Pn)
     if Pt is not None and np.size(Pt):
-        impulse = impulse + problem.Wt @ Pt
+        impulse = impulse + problem.Wt.dot(Pt)
     return impulse
 
 

@@ -7,12 +7,17 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.mechanics import kinetic_energy, velocity_after
+from lawbench.mechanics import velocity_after
 from lawbench.problem import ImpactProblem
 
 if TYPE_CHECKING:
     import pandas as pd
     from matplotlib.axes import Axes
+
+
+# The tangential impulse of a frictionless outcome: empty, shared, read-only.
+_NO_IMPULSE = np.zeros(0)
+_NO_IMPULSE.setflags(write=False)
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,14 +122,15 @@ class Outcome:
         path: dict[str, np.ndarray] | None = None,
     ) -> Outcome:
         """Build an outcome from a post-impact velocity a law computed itself."""
+        v_plus = np.asarray(v_plus, dtype=float)
         return cls(
-            v_plus=np.asarray(v_plus, dtype=float),
-            Pn=np.asarray(Pn, dtype=float),
-            Pt=np.zeros(0) if Pt is None else np.asarray(Pt, dtype=float),
-            T_minus=problem.T_minus,
-            T_plus=kinetic_energy(problem.M, v_plus),
-            status=status,
-            diagnostics=dict(diagnostics or {}),
-            path=path,
-            v_minus=np.asarray(problem.v, dtype=float),
+            v_plus,
+            np.asarray(Pn, dtype=float),
+            _NO_IMPULSE if Pt is None else np.asarray(Pt, dtype=float),
+            problem.T_minus,
+            problem.kinetic_energy(v_plus),
+            status,
+            dict(diagnostics or {}),
+            path,
+            problem.v,
         )

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import operator
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -20,6 +21,8 @@ import numpy as np
 from lawbench.errors import InvalidProblem
 
 RESTITUTION_KINDS = ("newton", "poisson", "energy")
+# The field of `Contact` that overrides ``e`` for each kind.
+_OVERRIDES = {kind: f"e_{kind}" for kind in RESTITUTION_KINDS}
 # Up to this many coordinates the inverse of M is kept: a product is cheaper than a solve.
 SMALL = 64
 # A matrix with at most this share of non-zero entries is multiplied as a sparse one.
@@ -63,22 +66,32 @@ class cached_property(Generic[_T]):  # noqa: N801 (named as the functools one it
 @np.errstate(over="ignore", invalid="ignore")
 def kinetic_energy(M: np.ndarray, v: np.ndarray) -> float:
     """Return ``v @ M @ v / 2`` (inf, without a warning, when it overflows)."""
-    return float(v @ M @ v) / 2.0
+    return float(v.dot(M.dot(v))) / 2.0
 
 
-# Up to this many entries an array is summed as Python floats: cheaper than a numpy reduction.
-SUMMED_IN_PYTHON = 64
+# Up to this many entries an array is reduced as Python floats: cheaper than a numpy reduction
+# (about 1 us each), and overflow and NaN propagate there without a warning.
+REDUCED_IN_PYTHON = 64
 
 
 def all_finite(array: np.ndarray) -> bool:
     """Whether every entry of ``array`` is finite.
 
     An infinite or NaN entry makes the sum non-finite, so a finite sum settles it in one
-    reduction (of Python floats for a small array: overflow and NaN propagate there without a
-    warning); only a non-finite sum (which overflow can also give) is looked at entry by entry.
+    reduction; only a non-finite sum (which overflow can also give) is looked at entry by entry.
     """
-    total = sum(array.ravel().tolist()) if array.size <= SUMMED_IN_PYTHON else array.sum()
+    total = sum(array.ravel().tolist()) if array.size <= REDUCED_IN_PYTHON else array.sum()
     return math.isfinite(total) or bool(np.isfinite(array).all())
+
+
+def smallest(array: np.ndarray) -> float:
+    """The smallest entry of a non-empty array of finite numbers."""
+    return min(array.tolist()) if array.size <= REDUCED_IN_PYTHON else float(array.min())
+
+
+def largest(array: np.ndarray) -> float:
+    """The largest entry of a non-empty array of finite numbers."""
+    return max(array.tolist()) if array.size <= REDUCED_IN_PYTHON else float(array.max())
 
 
 # Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
@@ -108,6 +121,10 @@ def _check_range(label: str, value: float, low: float, high: float | None = None
     if value < low or (high is not None and value > high):
         bounds = f"in [{low:g}, {high:g}]" if high is not None else f">= {low:g}"
         raise InvalidProblem(f"{label} = {value:g}: must be {bounds}")
+
+
+def _unknown_kind(kind: str) -> NoReturn:
+    raise ValueError(f"unknown restitution kind {kind!r}")
 
 
 @dataclass(frozen=True)
@@ -172,13 +189,14 @@ class Contact:
 
     def restitution(self, kind: str) -> float:
         """Return the coefficient of ``kind`` ('newton', 'poisson' or 'energy')."""
-        if kind not in RESTITUTION_KINDS:
-            raise ValueError(f"unknown restitution kind {kind!r}")
-        override = getattr(self, f"e_{kind}")
+        override = getattr(self, _OVERRIDES[kind]) if kind in _OVERRIDES else _unknown_kind(kind)
         return self.e if override is None else override
 
 
 CONTACT_FIELDS = frozenset(f.name for f in dataclasses.fields(Contact))
+# One coefficient for every contact, and what a coefficient may be.
+_SCALAR = (int, float, str)
+_NUMBER = (int, float, np.number)
 
 
 @functools.lru_cache(maxsize=256)
@@ -213,10 +231,15 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
     if array.shape != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
+    return _read_only_finite(name, array)
+
+
+def _read_only_finite(name: str, array: np.ndarray) -> np.ndarray:
+    """Make ``array`` (the problem's own copy) read-only, or raise naming a non-finite entry."""
     if not all_finite(array):
         index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
         raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
-    array.flags.writeable = False
+    array.setflags(write=False)
     return array
 
 
@@ -243,7 +266,7 @@ def _sparse_matrix(name: str, value: object, shape: tuple[int, int]) -> Any:
         )
     matrix.eliminate_zeros()
     for part in (matrix.data, matrix.indices, matrix.indptr):
-        part.flags.writeable = False
+        part.setflags(write=False)
     return matrix
 
 
@@ -277,7 +300,7 @@ def has_off_diagonal(M: Any) -> bool:
     return bool(np.any(coo.data[coo.row != coo.col]))
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class ImpactProblem:
     """An impact at a frozen configuration, validated when built.
 
@@ -318,50 +341,78 @@ class ImpactProblem:
     bodies: Mapping[str, Sequence[int]] = field(default_factory=dict)
     gaps: np.ndarray | None = None
 
-    def __post_init__(self) -> None:
-        v = np.array(self.v, dtype=float, ndmin=1)
+    def __init__(
+        self,
+        M: Any,
+        Wn: Any,
+        v: Any,
+        contacts: Sequence[Contact],
+        Wt: Any = None,
+        bodies: Mapping[str, Sequence[int]] | None = None,
+        gaps: Any = None,
+    ) -> None:
+        # Every field is checked here and the problem keeps its own read-only copies, written
+        # once into the instance (the dataclass is frozen).
+        v = np.array(v, dtype=float, ndmin=1)
         n = v.shape[0] if v.ndim == 1 else -1
         if n < 1:
             raise InvalidProblem(f"v has shape {v.shape}, expected (n,) with n >= 1")
-        contacts = tuple(self.contacts)
+        contacts = tuple(contacts)
         m = len(contacts)
         if m < 1:
             raise InvalidProblem("contacts is empty: an impact needs at least one contact")
+        repeated = 0
         for j, contact in enumerate(contacts):
             if j and contact is contacts[j - 1]:
+                repeated += 1
                 continue
             if not isinstance(contact, Contact):
                 raise InvalidProblem(f"contacts[{j}] is {type(contact).__name__}, not Contact")
-            contact.validate(f"contacts[{j}]")
-        set_ = object.__setattr__
-        sparse = n > SMALL and any(is_sparse(a) for a in (self.M, self.Wn, self.Wt))
+            if "_valid" not in contact.__dict__:
+                contact.validate(f"contacts[{j}]")
+        sparse = n > SMALL and any(is_sparse(a) for a in (M, Wn, Wt))
         matrix = _sparse_matrix if sparse else _matrix
-        set_(self, "v", _matrix("v", v, (n,)))
-        set_(self, "M", matrix("M", self.M, (n, n)))
-        set_(self, "Wn", matrix("Wn", self.Wn, (n, m)))
-        set_(self, "contacts", contacts)
-        if self.Wt is not None:
-            d = np.shape(self.Wt)[1] // m if np.ndim(self.Wt) == 2 else 0
-            if d not in (1, 2):
-                raise InvalidProblem(f"Wt has shape {np.shape(self.Wt)}, expected ({n}, {m}*d)")
-            set_(self, "Wt", matrix("Wt", self.Wt, (n, m * d)))
-        if self.gaps is None:
-            gaps = np.zeros(m)
-            gaps.flags.writeable = False
+        state = self.__dict__
+        state.update(
+            n=n,
+            m=m,
+            sparse=sparse,
+            v=_read_only_finite("v", v),
+            M=matrix("M", M, (n, n)),
+            Wn=matrix("Wn", Wn, (n, m)),
+            contacts=contacts,
+            Wt=None,
+            _restitutions={},
+            # One contact object for every contact: its coefficients are every contact's.
+            _shared_contact=contacts[0] if repeated == m - 1 else None,
+        )
+        if Wt is None:
+            state.update(frictional=False, d=0)
         else:
-            gaps = _matrix("gaps", self.gaps, (m,))
+            d = np.shape(Wt)[1] // m if np.ndim(Wt) == 2 else 0
+            if d not in (1, 2):
+                raise InvalidProblem(f"Wt has shape {np.shape(Wt)}, expected ({n}, {m}*d)")
+            state.update(Wt=matrix("Wt", Wt, (n, m * d)), d=d)
+        if gaps is None:
+            gaps = np.zeros(m)
+            gaps.setflags(write=False)
+            state["closed_count"] = m
+        else:
+            gaps = _matrix("gaps", gaps, (m,))
             if (gaps < 0).any():
                 j = int(np.argmax(gaps < 0))
                 raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
-        set_(self, "gaps", gaps)
-        bodies = {str(k): tuple(int(i) for i in idx) for k, idx in dict(self.bodies).items()}
-        for name, idx in bodies.items():
+        state["gaps"] = gaps
+        checked = {str(k): tuple(int(i) for i in idx) for k, idx in (bodies or {}).items()}
+        for name, idx in checked.items():
             if any(i < 0 or i >= n for i in idx):
                 raise InvalidProblem(f"bodies[{name!r}] = {idx}: indices must lie in [0, {n})")
-        set_(self, "bodies", bodies)
+        state["bodies"] = checked
         self._check_normals(self._factor_mass())
-        if not math.isfinite(self.T_minus):
-            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({self.T_minus})")
+        T_minus = self.kinetic_energy(self.v)
+        if not math.isfinite(T_minus):
+            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({T_minus})")
+        state["T_minus"] = T_minus
 
     @classmethod
     def from_arrays(
@@ -390,23 +441,23 @@ class ImpactProblem:
         InvalidProblem
             For an unknown coefficient, a sequence of the wrong length, or any bad field.
         """
-        m = np.shape(Wn)[1] if np.ndim(Wn) == 2 else 0
+        shape = Wn.shape if type(Wn) is np.ndarray else np.shape(Wn)
+        m = shape[1] if len(shape) == 2 else 0
         shared: dict[str, object] = {}
         per_contact: dict[str, list[object]] = {}
         for name, value in coefficients.items():
             if name not in CONTACT_FIELDS:
                 known = ", ".join(sorted(CONTACT_FIELDS))
                 raise InvalidProblem(f"unknown contact coefficient {name!r}; known: {known}")
-            one = isinstance(value, int | float | str) or not isinstance(
-                value, Sequence | np.ndarray
-            )
+            one = isinstance(value, _SCALAR) or not isinstance(value, Sequence | np.ndarray)
             if not one and len(value) != m:
                 raise InvalidProblem(
                     f"{name} has {len(value)} values, expected 1 or {m} (one per contact)"
                 )
-            values = [value] * m if one else list(value)
+            # A shared value is checked once, as contact 0's.
+            values = ([value] if m else []) if one else list(value)
             for j, entry in enumerate(values):
-                if entry is not None and not isinstance(entry, int | float | np.number):
+                if entry is not None and not isinstance(entry, _NUMBER):
                     raise InvalidProblem(f"contacts[{j}].{name} = {entry!r}: not a number")
             if one:
                 shared[name] = value
@@ -419,9 +470,10 @@ class ImpactProblem:
             ]
         else:
             # One set of coefficients: one (immutable) contact serves, validated once.
-            key = tuple(sorted((name, type(value), value) for name, value in shared.items()))
-            contacts = [_shared_contact(key)] * m
-        return cls(M, Wn, v, contacts, Wt, dict(bodies or {}), gaps)
+            key = [(name, type(value), value) for name, value in shared.items()]
+            key.sort()
+            contacts = [_shared_contact(tuple(key))] * m
+        return cls(M, Wn, v, contacts, Wt, bodies, gaps)
 
     def _factor_mass(self) -> float:
         """Check that M is symmetric positive definite and keep what `solve_mass` uses.
@@ -432,16 +484,18 @@ class ImpactProblem:
         """
         diagonal = self.M.diagonal()
         if not has_off_diagonal(self.M):
-            smallest = float(diagonal.min())
-            if not smallest > 0:
+            lightest = smallest(diagonal)
+            if not lightest > 0:
                 raise InvalidProblem("M is not positive definite")
-            if math.isinf(1.0 / smallest):
+            if math.isinf(1.0 / lightest):
                 self._too_close_to_singular()
             reciprocal = 1.0 / diagonal
-            reciprocal.flags.writeable = False
+            reciprocal.setflags(write=False)
             object.__setattr__(self, "_inverse_diagonal", reciprocal)
+            if diagonal.size <= REDUCED_IN_PYTHON:
+                object.__setattr__(self, "_masses", diagonal.tolist())
             # Rounded division is monotone: the largest reciprocal is that of the smallest mass.
-            return 1.0 / smallest
+            return 1.0 / lightest
         asymmetry = abs(self.M - self.M.T).max()
         if asymmetry > 1e-12 * abs(self.M).max():
             raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
@@ -462,7 +516,7 @@ class ImpactProblem:
         if not all_finite(inverse):
             self._too_close_to_singular()
         if self.n <= SMALL:
-            inverse.flags.writeable = False
+            inverse.setflags(write=False)
             object.__setattr__(self, "_inverse", inverse)
         return float(inverse.diagonal().max())
 
@@ -492,7 +546,7 @@ class ImpactProblem:
         # The squared Frobenius norm of W bounds its largest squared column: one product
         # settles the usual case.
         total = float(columns.sum()) if columns is not None else float(np.vdot(self.W, self.W))
-        if normal.min() > 1e-12 * inverse_mass * total:
+        if smallest(normal) > 1e-12 * inverse_mass * total:
             return
         if columns is None:
             columns = np.einsum("ij,ij->j", self.W, self.W)
@@ -503,17 +557,19 @@ class ImpactProblem:
                 f" = {normal[j]:.3g}): a singular configuration"
             )
 
-    @property
+    # The sizes are known once the problem is checked: `__post_init__` stores them, so that
+    # reading one is a dictionary look-up.
+    @cached_property
     def n(self) -> int:
         """Number of generalized coordinates."""
         return self.v.shape[0]
 
-    @property
+    @cached_property
     def m(self) -> int:
         """Number of contacts."""
         return len(self.contacts)
 
-    @property
+    @cached_property
     def d(self) -> int:
         """Tangential directions per contact: 0 without friction, 1 planar, 2 spatial."""
         return 0 if self.Wt is None else self.Wt.shape[1] // self.m
@@ -527,7 +583,7 @@ class ImpactProblem:
     def closed(self) -> np.ndarray:
         """Boolean mask of the contacts with zero gap, the ones an impact involves."""
         closed = self.gaps <= 0.0
-        closed.flags.writeable = False
+        closed.setflags(write=False)
         return closed
 
     @cached_property
@@ -538,7 +594,7 @@ class ImpactProblem:
     @cached_property
     def separating(self) -> tuple[int, ...]:
         """Closed contacts whose gap rate is positive before the impact (they separate)."""
-        if self.un.max() <= 0.0:
+        if largest(self.un) <= 0.0:
             return ()
         scale = float(np.abs(self.un).max())
         separating = self.closed & (self.un > SEPARATING * (scale or 1.0))
@@ -546,10 +602,22 @@ class ImpactProblem:
 
     @cached_property
     def T_minus(self) -> float:
-        """Kinetic energy before the impact, ``v @ M @ v / 2`` (inf when it overflows)."""
-        return kinetic_energy(self.M, self.v)
+        """Kinetic energy before the impact, ``v @ M @ v / 2`` (finite: checked when built)."""
+        return self.kinetic_energy(self.v)
 
-    @property
+    def kinetic_energy(self, v: np.ndarray) -> float:
+        """Kinetic energy ``v @ M @ v / 2`` of a velocity ``v`` (inf when it overflows).
+
+        A small diagonal M's in Python floats, from its diagonal: cheaper than numpy's calls.
+        """
+        masses = self.__dict__.get("_masses")
+        if masses is None:
+            return kinetic_energy(self.M, v)
+        velocities = v.tolist()
+        # x (m x), the products of numpy's v @ (M v).
+        return sum(map(operator.mul, velocities, map(operator.mul, masses, velocities))) / 2.0
+
+    @cached_property
     def sparse(self) -> bool:
         """Whether M, Wn and Wt are scipy.sparse CSC arrays (a large problem given sparse).
 
@@ -571,12 +639,14 @@ class ImpactProblem:
         The cached inverse of a small M, the reciprocal diagonal, or M's (sparse LU or
         Cholesky) factor; a sparse ``rhs`` gives a sparse answer.
         """
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None and type(rhs) is np.ndarray:
+            return reciprocal * rhs if rhs.ndim == 1 else reciprocal[:, None] * rhs
         if is_sparse(rhs):
             return self._mass_solved(rhs)
         inverse = self.__dict__.get("_inverse")
         if inverse is not None:
-            return inverse @ rhs
-        reciprocal = self.__dict__.get("_inverse_diagonal")
+            return inverse.dot(rhs)
         if reciprocal is not None:
             return reciprocal[:, None] * rhs if np.ndim(rhs) == 2 else reciprocal * rhs
         factor = self.__dict__.get("_sparse_factor")
@@ -621,17 +691,21 @@ class ImpactProblem:
             import scipy.sparse
 
             G = self._sparse_delassus(scipy.sparse.csc_array(self.Wn)).toarray()
+        elif "_inverse_diagonal" in self.__dict__:
+            # S.T S with S = M^-1/2 Wn: symmetric as computed (one product, no symmetrizing).
+            scaled = self.Wn * np.sqrt(self._inverse_diagonal)[:, None]
+            G = scaled.T.dot(scaled)
         else:
-            G = self.Wn.T @ self.solve_mass(self.Wn)
+            G = self.Wn.T.dot(self.solve_mass(self.Wn))
             G = (G + G.T) / 2
-        G.flags.writeable = False
+        G.setflags(write=False)
         return G
 
     @cached_property
     def un(self) -> np.ndarray:
         """Pre-impact normal gap rates ``Wn.T @ v``."""
-        un = self.Wn.T @ self.v
-        un.flags.writeable = False
+        un = self.Wn.T.dot(self.v)
+        un.setflags(write=False)
         return un
 
     @cached_property
@@ -657,7 +731,7 @@ class ImpactProblem:
             return self._sparse_delassus(self.W)
         G = self.W.T @ self.solve_mass(self.W)
         G = (G + G.T) / 2
-        G.flags.writeable = False
+        G.setflags(write=False)
         return G
 
     @cached_property
@@ -669,24 +743,21 @@ class ImpactProblem:
     def mu(self) -> np.ndarray:
         """Friction coefficients, one per contact."""
         mu = np.array([c.mu for c in self.contacts])
-        mu.flags.writeable = False
+        mu.setflags(write=False)
         return mu
 
     def restitution(self, kind: str) -> np.ndarray:
         """Per-contact restitution coefficients of ``kind`` ('newton', 'poisson', 'energy')."""
         coefficients = self._restitutions.get(kind)
         if coefficients is None:
-            if kind not in RESTITUTION_KINDS:
-                raise ValueError(f"unknown restitution kind {kind!r}")
-            coefficients = np.array([c.restitution(kind) for c in self.contacts])
-            coefficients.flags.writeable = False
+            shared = self._shared_contact
+            if shared is not None:
+                coefficients = np.array([shared.restitution(kind)] * self.m)
+            else:
+                coefficients = np.array([c.restitution(kind) for c in self.contacts])
+            coefficients.setflags(write=False)
             self._restitutions[kind] = coefficients
         return coefficients
-
-    @cached_property
-    def _restitutions(self) -> dict[str, np.ndarray]:
-        """The coefficients of each kind asked for so far."""
-        return {}
 
     def select_contacts(self, mask: np.ndarray) -> ImpactProblem:
         """Return the problem restricted to the contacts where ``mask`` is true."""
