@@ -199,13 +199,13 @@ _SCALAR = (int, float, str)
 _NUMBER = (int, float, np.number)
 
 
-@functools.lru_cache(maxsize=256)
-def _shared_contact(coefficients: tuple[tuple[str, type, object], ...]) -> Contact:
+@functools.lru_cache(maxsize=256, typed=True)
+def _shared_contact(**coefficients: Any) -> Contact:
     """The one contact of coefficients every contact shares: built (and checked) once.
 
-    Each value comes with its type, so that 1 and 1.0, equal as keys, build their own contact.
+    Typed: 1 and 1.0, equal as keys, build their own contact.
     """
-    return Contact(**{name: value for name, _, value in coefficients})
+    return Contact(**coefficients)
 
 
 def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray:
@@ -470,9 +470,7 @@ class ImpactProblem:
             ]
         else:
             # One set of coefficients: one (immutable) contact serves, validated once.
-            key = [(name, type(value), value) for name, value in shared.items()]
-            key.sort()
-            contacts = [_shared_contact(tuple(key))] * m
+            contacts = (_shared_contact(**shared),) * m
         return cls(M, Wn, v, contacts, Wt, bodies, gaps)
 
     def _factor_mass(self) -> float:
