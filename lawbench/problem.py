@@ -208,6 +208,14 @@ def _shared_contact(**coefficients: Any) -> Contact:
     return Contact(**coefficients)
 
 
+@functools.lru_cache(maxsize=64)
+def _no_gaps(m: int) -> np.ndarray:
+    """The gaps of m closed contacts: zeros, read-only, one array shared by every such problem."""
+    gaps = np.zeros(m)
+    gaps.setflags(write=False)
+    return gaps
+
+
 def _cho_solve(cholesky: tuple[np.ndarray, bool], rhs: np.ndarray) -> np.ndarray:
     """``M^-1 rhs`` from M's lower Cholesky factor.
 
@@ -394,8 +402,7 @@ class ImpactProblem:
                 raise InvalidProblem(f"Wt has shape {np.shape(Wt)}, expected ({n}, {m}*d)")
             state.update(Wt=matrix("Wt", Wt, (n, m * d)), d=d)
         if gaps is None:
-            gaps = np.zeros(m)
-            gaps.setflags(write=False)
+            gaps = _no_gaps(m)
             state["closed_count"] = m
         else:
             gaps = _matrix("gaps", gaps, (m,))
@@ -403,10 +410,12 @@ class ImpactProblem:
                 j = int(np.argmax(gaps < 0))
                 raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
         state["gaps"] = gaps
-        checked = {str(k): tuple(int(i) for i in idx) for k, idx in (bodies or {}).items()}
-        for name, idx in checked.items():
+        checked: dict[str, tuple[int, ...]] = {}
+        for name, indices in (bodies or {}).items():
+            idx = tuple(int(i) for i in indices)
             if any(i < 0 or i >= n for i in idx):
-                raise InvalidProblem(f"bodies[{name!r}] = {idx}: indices must lie in [0, {n})")
+                raise InvalidProblem(f"bodies[{str(name)!r}] = {idx}: indices must lie in [0, {n})")
+            checked[str(name)] = idx
         state["bodies"] = checked
         self._check_normals(self._factor_mass())
         T_minus = self.kinetic_energy(self.v)
@@ -543,11 +552,12 @@ class ImpactProblem:
             normal, columns = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn)), None
         # The squared Frobenius norm of W bounds its largest squared column: one product
         # settles the usual case.
-        total = float(columns.sum()) if columns is not None else float(np.vdot(self.W, self.W))
+        W = self.Wn if self.Wt is None else self.W
+        total = float(columns.sum()) if columns is not None else float(np.vdot(W, W))
         if smallest(normal) > 1e-12 * inverse_mass * total:
             return
         if columns is None:
-            columns = np.einsum("ij,ij->j", self.W, self.W)
+            columns = np.einsum("ij,ij->j", W, W)
         scale = inverse_mass * float(columns.max())
         for j in np.flatnonzero(normal <= 1e-12 * scale):
             raise InvalidProblem(
