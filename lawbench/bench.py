@@ -95,13 +95,10 @@ def numpy_enumeration(M: np.ndarray, Wn: np.ndarray, v: np.ndarray, e: float) ->
 
 # Siconos numerics (the reference nonsmooth-mechanics library, C) is measured when the
 # interpreter below imports it (Debian: python3-siconos): Lemke on the same chain's LCP (its
-# matrix is dense), building its matrix and vector included, ``number`` calls at a time. A
-# fresh process first runs for WARM_UP_S seconds: timed at once, a few thousand calls ran at
-# about two thirds of their steady speed here (10 us instead of 6.6 us).
-WARM_UP_S = 0.3
+# matrix is dense), building its matrix and vector included, ``number`` calls at a time.
 SICONOS_PYTHON = os.environ.get("LAWBENCH_SICONOS_PYTHON", "/usr/bin/python3")
-SICONOS_SCRIPT = """
-import time, numpy as np, siconos.numerics as sn
+SICONOS_SETUP = """
+import numpy as np, siconos.numerics as sn
 masses, v, e = np.array({masses}), np.array({v}), {e}
 n = len(masses); index = np.arange(n - 1)
 Wn = np.zeros((n, n - 1)); Wn[index, index] = -1.0; Wn[index + 1, index] = 1.0
@@ -110,6 +107,25 @@ def one():
     z, w = np.zeros(n - 1), np.zeros(n - 1)
     sn.lcp_lexicolemke(sn.LCP(D, q), z, w, sn.SolverOptions(sn.SICONOS_LCP_LEMKE))
     return z
+"""
+
+# A pure-Python loop timed in two interpreters: a small impact is bound by the interpreter
+# (its calls, not its arithmetic), so the ratio of the two times is the part of a ratio
+# against Siconos that comes from running on another build of CPython.
+PYTHON_LOOP_SETUP = """
+def one():
+    total = 0
+    for i in range(100_000):
+        total += i * i
+    return total
+"""
+
+# How another interpreter times ``one()`` of a setup: the fastest of ``repeats`` means of
+# ``number`` calls, after WARM_UP_S seconds of calls (timed at once, a fresh process ran a
+# few thousand Lemke solves at two thirds of their steady speed here: 10 us instead of 6.6 us).
+WARM_UP_S = 0.3
+TIMED = """
+import time
 warm = time.perf_counter() + {warm_up}
 while time.perf_counter() < warm: one()
 times = []
@@ -125,40 +141,18 @@ def siconos_lemke(
     masses: np.ndarray, v: np.ndarray, repeats: int, number: int = 200, e: float = 0.9
 ) -> float | None:
     """Fastest seconds per Lemke solve of a free chain in Siconos numerics, or None if absent."""
-    script = SICONOS_SCRIPT.format(
-        masses=masses.tolist(), v=v.tolist(), e=e, repeats=repeats, number=number, warm_up=WARM_UP_S
-    )
-    return _seconds_printed(SICONOS_PYTHON, script)
-
-
-# A pure-Python loop timed in two interpreters: a small impact is bound by the interpreter
-# (its calls, not its arithmetic), so the ratio of the two times is the part of a ratio
-# against Siconos that comes from running on another build of CPython.
-PYTHON_LOOP = """
-import time
-def loop():
-    total = 0
-    for i in range(100_000):
-        total += i * i
-    return total
-warm = time.perf_counter() + {warm_up}
-while time.perf_counter() < warm: loop()
-times = []
-for _ in range({repeats}):
-    start = time.perf_counter()
-    loop()
-    times.append(time.perf_counter() - start)
-print(min(times))
-"""
+    setup = SICONOS_SETUP.format(masses=masses.tolist(), v=v.tolist(), e=e)
+    return _seconds_of_one(SICONOS_PYTHON, setup, repeats, number)
 
 
 def python_loop(python: str, repeats: int) -> float | None:
     """Fastest seconds of a pure-Python loop in the interpreter ``python``, or None if absent."""
-    return _seconds_printed(python, PYTHON_LOOP.format(repeats=repeats, warm_up=WARM_UP_S))
+    return _seconds_of_one(python, PYTHON_LOOP_SETUP, repeats, 1)
 
 
-def _seconds_printed(python: str, script: str) -> float | None:
-    """The number of seconds ``script`` prints when run by ``python``, or None if it fails."""
+def _seconds_of_one(python: str, setup: str, repeats: int, number: int) -> float | None:
+    """Seconds per call of ``one()`` defined by ``setup``, timed by ``python``; None if it fails."""
+    script = setup + TIMED.format(warm_up=WARM_UP_S, repeats=repeats, number=number)
     try:
         done = subprocess.run([python, "-c", script], capture_output=True, text=True, timeout=120)
     except (OSError, subprocess.TimeoutExpired):

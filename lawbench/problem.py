@@ -490,7 +490,10 @@ class ImpactProblem:
         Returns the largest diagonal entry of M^-1 (a lower bound of it when sparse).
         """
         diagonal = self.M.diagonal()
-        if not has_off_diagonal(self.M):
+        # A positive definite M has no zero on its diagonal: with n non-zero entries it is
+        # diagonal, and with fewer, or a zero on the diagonal, the test below refuses it.
+        stored = self.M.count_nonzero() if self.sparse else np.count_nonzero(self.M)
+        if stored <= self.n:
             lightest = smallest(diagonal)
             if not lightest > 0:
                 raise InvalidProblem("M is not positive definite")
