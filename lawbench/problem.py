@@ -21,8 +21,6 @@ import numpy as np
 from lawbench.errors import InvalidProblem
 
 RESTITUTION_KINDS = ("newton", "poisson", "energy")
-# The field of `Contact` that overrides ``e`` for each kind.
-_OVERRIDES = {kind: f"e_{kind}" for kind in RESTITUTION_KINDS}
 # Up to this many coordinates the inverse of M is kept: a product is cheaper than a solve.
 SMALL = 64
 # A matrix with at most this share of non-zero entries is multiplied as a sparse one.
@@ -123,10 +121,6 @@ def _check_range(label: str, value: float, low: float, high: float | None = None
         raise InvalidProblem(f"{label} = {value:g}: must be {bounds}")
 
 
-def _unknown_kind(kind: str) -> NoReturn:
-    raise ValueError(f"unknown restitution kind {kind!r}")
-
-
 @dataclass(frozen=True)
 class Contact:
     """Parameters of one contact.
@@ -189,7 +183,9 @@ class Contact:
 
     def restitution(self, kind: str) -> float:
         """Return the coefficient of ``kind`` ('newton', 'poisson' or 'energy')."""
-        override = getattr(self, _OVERRIDES[kind]) if kind in _OVERRIDES else _unknown_kind(kind)
+        if kind not in RESTITUTION_KINDS:
+            raise ValueError(f"unknown restitution kind {kind!r}")
+        override = getattr(self, f"e_{kind}")
         return self.e if override is None else override
 
 
@@ -392,7 +388,7 @@ class ImpactProblem:
             Wt=None,
             _restitutions={},
             # One contact object for every contact: its coefficients are every contact's.
-            _shared_contact=contacts[0] if repeated == m - 1 else None,
+            _one_contact=contacts[0] if repeated == m - 1 else None,
         )
         if Wt is None:
             state.update(frictional=False, d=0)
@@ -568,7 +564,7 @@ class ImpactProblem:
                 f" = {normal[j]:.3g}): a singular configuration"
             )
 
-    # The sizes are known once the problem is checked: `__post_init__` stores them, so that
+    # The sizes are known once the problem is checked: `__init__` stores them, so that
     # reading one is a dictionary look-up.
     @cached_property
     def n(self) -> int:
@@ -651,15 +647,13 @@ class ImpactProblem:
         Cholesky) factor; a sparse ``rhs`` gives a sparse answer.
         """
         reciprocal = self.__dict__.get("_inverse_diagonal")
-        if reciprocal is not None and type(rhs) is np.ndarray:
-            return reciprocal * rhs if rhs.ndim == 1 else reciprocal[:, None] * rhs
+        if reciprocal is not None and not is_sparse(rhs):
+            return reciprocal * rhs if np.ndim(rhs) == 1 else reciprocal[:, None] * rhs
         if is_sparse(rhs):
             return self._mass_solved(rhs)
         inverse = self.__dict__.get("_inverse")
         if inverse is not None:
             return inverse.dot(rhs)
-        if reciprocal is not None:
-            return reciprocal[:, None] * rhs if np.ndim(rhs) == 2 else reciprocal * rhs
         factor = self.__dict__.get("_sparse_factor")
         if factor is not None:
             return factor.solve(np.asarray(rhs, dtype=float))
@@ -761,9 +755,9 @@ class ImpactProblem:
         """Per-contact restitution coefficients of ``kind`` ('newton', 'poisson', 'energy')."""
         coefficients = self._restitutions.get(kind)
         if coefficients is None:
-            shared = self._shared_contact
-            if shared is not None:
-                coefficients = np.array([shared.restitution(kind)] * self.m)
+            one = self._one_contact
+            if one is not None:
+                coefficients = np.array([one.restitution(kind)] * self.m)
             else:
                 coefficients = np.array([c.restitution(kind) for c in self.contacts])
             coefficients.setflags(write=False)
