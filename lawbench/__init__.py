@@ -9,7 +9,6 @@ identifies a law's coefficients from measured pre- and post-impact velocities.
 import importlib
 
 from lawbench.api import evaluate, solve, solve_batch
-from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.case import CASES, Case, GroundTruth, Reference
 from lawbench.checks import CHECKS, CheckResult, Trial, run_checks
 from lawbench.errors import (
@@ -27,8 +26,11 @@ from lawbench.tags import Tags
 from lawbench.verdicts import Claim, Region, Verdict
 
 # Loaded when first asked for: problem files need scipy.sparse (and h5py for HDF5), fitting
-# needs pandas and scipy.optimize, run tables pandas and pyarrow, figures matplotlib.
+# needs pandas and scipy.optimize, run tables pandas and pyarrow, figures matplotlib; batches
+# are more code than a single solve reads.
 _LAZY = {
+    "OutcomeBatch": "lawbench.batch",
+    "ProblemBatch": "lawbench.batch",
     "load_problem": "lawbench.problem_files",
     "save_problem": "lawbench.problem_files",
     "fit": "lawbench.fitting",

@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.case import CASES, Case
 from lawbench.checks import Trial
 from lawbench.errors import InvalidProblem
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem
+
+if TYPE_CHECKING:
+    from lawbench.batch import OutcomeBatch, ProblemBatch
 
 
 def solve(
@@ -122,6 +124,8 @@ def solve_batch(
     >>> lawbench.solve_batch("moreau", batch).v_plus.round(6).tolist()
     [[-0.333333, 0.666667, 0.666667], [0.0, 1.0, 2.0]]
     """
+    from lawbench.batch import ProblemBatch  # on first use: a single solve needs no batch
+
     if not isinstance(batch, ProblemBatch):
         batch = ProblemBatch.from_problems(list(batch))
     return LAWS.get(law).resolve_batch(batch, **dict(options or {}))

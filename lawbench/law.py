@@ -15,12 +15,11 @@ import functools
 import math
 import time
 from abc import ABC, abstractmethod
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from lawbench import budget
-from lawbench.batch import OutcomeBatch, ProblemBatch
 from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.outcome import Outcome
 from lawbench.problem import ImpactProblem, all_finite
@@ -28,6 +27,9 @@ from lawbench.registry import Registry
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim
+
+if TYPE_CHECKING:
+    from lawbench.batch import OutcomeBatch, ProblemBatch
 
 
 class Law(ABC):
@@ -176,6 +178,8 @@ class Law(ABC):
         InvalidProblem, NotApplicable, SolverFailure
             As `resolve`; one by one, the first problem that raises stops the batch.
         """
+        from lawbench.batch import OutcomeBatch  # on first use: a single solve needs no batch
+
         values = self.option_values(options)
         start = time.perf_counter()
         Pn = self._resolve_batch(batch, values)

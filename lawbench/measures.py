@@ -15,7 +15,6 @@ ground truth once per worker. A measure returns None where it does not apply.
 
 from __future__ import annotations
 
-import hashlib
 import json
 from typing import Any
 
@@ -35,6 +34,8 @@ _SOLVED: dict[str, np.ndarray | None] = {}
 
 
 def _digest(problem: ImpactProblem) -> str:
+    import hashlib  # on first use: it loads OpenSSL, 3 ms of a small command's start-up
+
     digest = hashlib.sha1(repr(problem.contacts).encode())
     for part in (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps):
         if part is None:

@@ -33,7 +33,6 @@ reference: declare them as module-level functions (or `functools.partial` of one
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import itertools
 import json
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -98,6 +97,8 @@ class Job:
         if self.transform or self.repeat:
             content += [self.transform, self.repeat]
         text = json.dumps(content, sort_keys=True)
+        import hashlib  # on first use: it loads OpenSSL, 3 ms of a small command's start-up
+
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
     def solve(self, settings: Mapping[str, Any] | None = None) -> Trial:

@@ -78,12 +78,11 @@ and ``-e Pn un-`` outweighs the losses.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lawbench import budget, cones
-from lawbench.batch import ProblemBatch
 from lawbench.claims import (
     PAOLI_DISCONTINUITY,
     RIGID_DISPERSION,
@@ -99,6 +98,9 @@ from lawbench.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, so
 from lawbench.spec import Spec
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim
+
+if TYPE_CHECKING:
+    from lawbench.batch import ProblemBatch
 
 _SLIP_REVERSAL = (
     "kinematic restitution with Coulomb friction on the post-impact slip (at one contact "

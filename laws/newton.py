@@ -15,11 +15,10 @@ asked to approach at ``-e un-``; the impulses are whatever the linear system giv
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.batch import ProblemBatch
 from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 from lawbench.errors import NotApplicable
 from lawbench.law import LAWS, Law
@@ -29,6 +28,9 @@ from lawbench.problem import ImpactProblem
 from lawbench.regions import separating_contact
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim
+
+if TYPE_CHECKING:
+    from lawbench.batch import ProblemBatch
 
 _SOURCE = "Brogliato 2010, eq. (29) and the discussion of separating contacts after it"
 _ASKS_APPROACH = (

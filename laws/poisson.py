@@ -20,11 +20,10 @@ only what keeps it from approaching (L). For one approaching contact the law equ
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.batch import ProblemBatch
 from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 from lawbench.law import LAWS, Law
 from lawbench.outcome import Outcome
@@ -33,6 +32,9 @@ from lawbench.regions import separating_contact
 from lawbench.solvers import ENUMERATION_MAX, enumerate_lcp, solve_lcp
 from lawbench.tags import Tags
 from lawbench.verdicts import Claim
+
+if TYPE_CHECKING:
+    from lawbench.batch import ProblemBatch
 
 
 class Poisson(Law):
