@@ -448,15 +448,17 @@ def test_small_commands_import_no_heavy_library(argv):
     assert done.stdout.strip() == "[]"
 
 
-def test_a_solve_of_built_in_entries_reads_no_installed_metadata():
+@pytest.mark.parametrize("module", ["importlib.metadata", "lawbench.batch"])
+def test_a_solve_of_built_in_entries_reads_no_metadata_and_no_batch_code(module):
     """A built-in law on a built-in scene needs no plugin lookup and no version: the package
-    metadata (a third of the start-up) is read only for ``list``, plugins and ``--version``."""
+    metadata (a third of the start-up) is read only for ``list``, plugins and ``--version``;
+    nor does one solve read the batch module, compiled at every start without cached bytecode."""
     code = (
         "import contextlib, io, sys\n"
         "from lawbench.cli import main\n"
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         "    main(['solve', 'newton', 'three_ball_chain'])\n"
-        "print('importlib.metadata' in sys.modules)\n"
+        f"print({module!r} in sys.modules)\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr

@@ -6,6 +6,9 @@ a batch carries the enumeration over every problem at once. Each gives the gener
 answer: the same numbers bit for bit where the formulas are the same, else to 1e-12.
 """
 
+import dataclasses
+import warnings
+
 import numpy as np
 import pytest
 
@@ -121,3 +124,47 @@ def test_a_small_diagonal_mass_is_inverted_exactly():
     np.testing.assert_allclose(problem.delassus, [[1e3 + 1 / 3]], rtol=1e-15)
     with pytest.raises(InvalidProblem, match="M is too close to singular"):
         ImpactProblem.from_arrays(np.diag([1.0, 1e-320]), [[-1.0], [1.0]], [1.0, 0.0])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_delassus_matrix_of_a_diagonal_mass_is_symmetric_as_computed(seed):
+    """G = S.T S with S = M^-1/2 Wn is symmetric bit for bit and equals Wn.T M^-1 Wn."""
+    rng = np.random.default_rng(seed)
+    n, m = 6, 4
+    M = np.diag(10.0 ** rng.uniform(-3.0, 3.0, n))
+    Wn = rng.normal(size=(n, m))
+    G = ImpactProblem.from_arrays(M, Wn, rng.normal(size=n)).delassus
+    assert np.array_equal(G, G.T)
+    np.testing.assert_allclose(G, Wn.T @ np.linalg.solve(M, Wn), rtol=1e-13)
+
+
+def test_the_kinetic_energy_of_a_small_diagonal_mass_is_numpys_and_overflows_silently():
+    """T = v.M v / 2 in Python floats equals numpy's to rounding; past the float range it is
+    inf without a warning (a law's outcome is then refused by name, not with a warning)."""
+    rng = np.random.default_rng(0)
+    M = np.diag(10.0 ** rng.uniform(-3.0, 3.0, 5))
+    problem = ImpactProblem.from_arrays(M, rng.normal(size=(5, 2)), rng.normal(size=5))
+    v = rng.normal(size=5)
+    assert problem.kinetic_energy(v) == pytest.approx(v @ M @ v / 2, rel=1e-15)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert problem.kinetic_energy(np.full(5, 1e200)) == np.inf
+
+
+@pytest.mark.parametrize(
+    "M", [[[0.0, 1.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, -1.0]], [[1.0, 0.0], [0.0, 0.0]]]
+)
+def test_a_mass_matrix_with_at_most_n_non_zero_entries_is_diagonal_or_refused(M):
+    """A positive definite M has no zero on its diagonal, so n non-zero entries make it
+    diagonal; any other M with n non-zero entries or fewer is refused, never read as one."""
+    with pytest.raises(InvalidProblem, match="M is not positive definite"):
+        ImpactProblem.from_arrays(np.array(M), [[-1.0], [1.0]], [1.0, 0.0])
+
+
+def test_an_outcome_is_frozen_and_replaced_field_by_field():
+    outcome = lawbench.solve("moreau", "three_ball_chain")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        outcome.status = "changed"
+    changed = dataclasses.replace(outcome, status="ambiguous")
+    assert changed.status == "ambiguous" and changed.T_plus == outcome.T_plus
+    assert changed.diagnostics == outcome.diagnostics
