@@ -35,6 +35,12 @@ from lawbench.law import LAWS
 from lawbench.problem import ImpactProblem
 from lawbench.solvers import clarabel_settings, enumerate_lcp
 
+# The law whose impulses solve the frictionless LCP ``0 <= G z + q _|_ z >= 0`` that the peers
+# (clarabel, the numpy enumeration, Siconos' Lemke) solve, and the small command whose start-up
+# is timed: the figures of the speed targets are defined on these two.
+LCP_LAW = "moreau"
+START_UP_COMMAND = ("solve", "newton", "three_ball_chain")
+
 # Chain lengths of the full report: the growth from 1,000 to 10,000 balls shows the cost per ball.
 CHAINS = (100, 1000, 10_000)
 
@@ -55,6 +61,23 @@ def best_time(function: Callable[[], Any], repeats: int, number: int = 1) -> flo
             function()
         times.append((time.perf_counter() - start) / number)
     return min(times)
+
+
+def alternated(
+    measures: dict[str, Callable[[], float | None]], rounds: int
+) -> dict[str, float | None]:
+    """The fastest of each measure over ``rounds`` rounds that take every measure in turn.
+
+    The machine's speed drifts within a run (the same pure-Python loop took 3.9 ms to 7.3 ms
+    here): alternating lets both sides of a ratio meet it in the same states. A measure that
+    fails (None) once is None.
+    """
+    best: dict[str, float | None] = dict.fromkeys(measures, math.inf)
+    for _ in range(rounds):
+        for name, measure in measures.items():
+            seconds, so_far = measure(), best[name]
+            best[name] = None if seconds is None or so_far is None else min(so_far, seconds)
+    return best
 
 
 def chain_arrays(balls: int, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
@@ -173,39 +196,33 @@ def _time(seconds: float) -> str:
 
 
 def small_impact(repeats: int, rounds: int = 3) -> list[str]:
-    """One three-ball Moreau impact: from a prebuilt problem, and from matrices.
+    """One three-ball impact of `LCP_LAW`: from a prebuilt problem, and from matrices.
 
     lawbench's two figures, Siconos' and the pure-Python loop in both interpreters are taken in
-    ``rounds`` alternating rounds, each keeping its fastest: the machine's speed drifts within
-    a run (the same loop took 3.9 ms to 7.3 ms here), and alternating lets both sides of a
-    ratio meet it in the same states.
+    ``rounds`` `alternated` rounds.
     """
     M, Wn, v = chain_arrays(3, np.random.default_rng(0))
-    moreau = LAWS.get("moreau")
+    law = LAWS.get(LCP_LAW)
     problem = ImpactProblem.from_arrays(M, Wn, v, e=0.9)
     peers = {
         "clarabel direct": best_time(lambda: clarabel_direct(M, Wn, v, 0.9), repeats, 200),
         "numpy enumeration": best_time(lambda: numpy_enumeration(M, Wn, v, 0.9), repeats, 200),
     }
     measures: dict[str, Callable[[], float | None]] = {
-        "prebuilt": lambda: best_time(lambda: moreau.resolve(problem), repeats, 1000),
+        "prebuilt": lambda: best_time(lambda: law.resolve(problem), repeats, 1000),
         "built": lambda: best_time(
-            lambda: moreau.resolve(ImpactProblem.from_arrays(M, Wn, v, e=0.9)), repeats, 1000
+            lambda: law.resolve(ImpactProblem.from_arrays(M, Wn, v, e=0.9)), repeats, 1000
         ),
         "Siconos Lemke": lambda: siconos_lemke(np.diag(M), v, repeats, 1000),
         "loop here": lambda: python_loop(sys.executable, repeats),
         "loop there": lambda: python_loop(SICONOS_PYTHON, repeats),
     }
-    best: dict[str, float | None] = dict.fromkeys(measures, math.inf)
-    for _ in range(rounds):
-        for name, measure in measures.items():
-            seconds = measure()
-            best[name] = None if seconds is None or best[name] is None else min(best[name], seconds)
+    best = alternated(measures, rounds)
     siconos = best["Siconos Lemke"]
     if siconos is not None:
         peers["Siconos Lemke"] = siconos
     lines = [
-        "one three-ball Moreau impact (e = 0.9):",
+        f"one three-ball {LCP_LAW} impact (e = 0.9):",
         _row("lawbench, prebuilt problem", best["prebuilt"], peers),
         _row("lawbench, from matrices (problem built)", best["built"], peers),
         *(f"  {name:<46}{_time(t):>12}" for name, t in peers.items()),
@@ -230,11 +247,11 @@ def batch_of_impacts(size: int, repeats: int) -> list[str]:
     _, Wn, _ = chain_arrays(3, rng)
     v = rng.normal(size=(size, 3))
     e = rng.uniform(0.0, 1.0, (size, 2))
-    whole = best_time(lambda: solve_batch("moreau", ProblemBatch(M, Wn, v, {"e": e})), repeats)
+    law = LAWS.get(LCP_LAW)
+    whole = best_time(lambda: solve_batch(law, ProblemBatch(M, Wn, v, {"e": e})), repeats)
     sample = ProblemBatch(M[:200], Wn, v[:200], {"e": e[:200]})
-    moreau = LAWS.get("moreau")
     one_by_one = (
-        best_time(lambda: [moreau.resolve(sample.problem(k)) for k in range(200)], repeats) / 200
+        best_time(lambda: [law.resolve(sample.problem(k)) for k in range(200)], repeats) / 200
     )
     peers = {
         "one by one": one_by_one,
@@ -244,19 +261,19 @@ def batch_of_impacts(size: int, repeats: int) -> list[str]:
     if siconos is not None:
         peers["Siconos Lemke one by one"] = siconos
     return [
-        f"a batch of {size:,} random three-ball Moreau impacts (validation included):",
+        f"a batch of {size:,} random three-ball {LCP_LAW} impacts (validation included):",
         _row("lawbench solve_batch, per impact", whole / size, peers),
     ]
 
 
 def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) -> list[str]:
-    """Moreau on n-ball chains, built as the chain scenes build them (sparse when long).
+    """`LCP_LAW` on n-ball chains, built as the chain scenes build them (sparse when long).
 
     Against clarabel called directly on the sparse QP and, up to ``siconos_up_to`` balls,
     Siconos' Lemke on the dense LCP; the last line is the growth exponent of lawbench's time
     between the two longest chains.
     """
-    moreau, lines = LAWS.get("moreau"), ["Moreau on an n-ball chain (e = 0.5):"]
+    law, lines = LAWS.get(LCP_LAW), [f"{LCP_LAW} on an n-ball chain (e = 0.5):"]
     times = []
     for balls in sizes:
         rng = np.random.default_rng(balls)
@@ -273,7 +290,7 @@ def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) ->
         siconos = siconos_lemke(masses, v, 3, 1, 0.5) if balls <= siconos_up_to else None
         if siconos is not None:
             peers["Siconos Lemke"] = siconos
-        times.append(best_time(lambda p=problem: moreau.resolve(p), repeats))
+        times.append(best_time(lambda p=problem: law.resolve(p), repeats))
         lines.append(_row(f"n = {balls}, prebuilt problem", times[-1], peers))
     if len(sizes) > 1:
         growth = np.log(times[-1] / times[-2]) / np.log(sizes[-1] / sizes[-2])
@@ -328,28 +345,30 @@ def _elastic_chain(balls: int) -> ImpactProblem:
 
 
 def start_up(repeats: int) -> list[str]:
-    """Whole-process time of a Newton solve against importing numpy alone.
+    """Whole-process time of the small command `START_UP_COMMAND` against importing numpy.
 
     Both with their bytecode cached, as after a first run (in a temporary
     ``PYTHONPYCACHEPREFIX``, so that nothing is written beside the sources), and, when this
     environment sets ``PYTHONDONTWRITEBYTECODE``, as it runs them: every module that has no
     cached bytecode (an editable install's own) compiled at every start.
     """
-    solve = [sys.executable, "-m", "lawbench", "solve", "newton", "three_ball_chain"]
-    numpy_only = [sys.executable, "-c", "import numpy"]
+    commands = {
+        "lawbench": [sys.executable, "-m", "lawbench", *START_UP_COMMAND],
+        "numpy": [sys.executable, "-c", "import numpy"],
+    }
 
     def pair(label: str, env: dict[str, str]) -> str:
-        def run(command: list[str]) -> Callable[[], None]:
-            return lambda: subprocess.run(command, capture_output=True, check=True, env=env)
+        def timed(command: list[str]) -> Callable[[], float]:
+            def run() -> None:
+                subprocess.run(command, capture_output=True, check=True, env=env)
 
-        ours, peer = run(solve), run(numpy_only)
-        ours(), peer()  # a first run fills the cache
-        # Alternated, each keeping its fastest: both meet the machine in the same states.
-        times = [(best_time(ours, 1), best_time(peer, 1)) for _ in range(repeats)]
-        fastest = min(t for t, _ in times), min(t for _, t in times)
-        return _row(label, fastest[0], {'python -c "import numpy"': fastest[1]})
+            run()  # a first run fills the cache
+            return lambda: best_time(run, 1)
 
-    lines = ["start-up, whole process, lawbench solve newton three_ball_chain:"]
+        best = alternated({name: timed(command) for name, command in commands.items()}, repeats)
+        return _row(label, best["lawbench"], {'python -c "import numpy"': best["numpy"]})
+
+    lines = [f"start-up, whole process, lawbench {' '.join(START_UP_COMMAND)}:"]
     with tempfile.TemporaryDirectory() as cache:
         cached = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
         lines.append(pair("bytecode cached", {**cached, "PYTHONPYCACHEPREFIX": cache}))

@@ -330,6 +330,19 @@ class ImpactProblem:
         Initial gaps; None means zero (a simultaneous impact). A contact with a positive gap is
         open: the rigid laws leave it alone at this instant.
 
+    Attributes
+    ----------
+    n, m : int
+        Numbers of generalized coordinates and of contacts.
+    d : int
+        Tangential directions per contact: 0 without friction, 1 planar, 2 spatial.
+    sparse : bool
+        Whether M, Wn and Wt are scipy.sparse CSC arrays (a large problem given sparse). Then
+        `delassus`, `W` and `contact_delassus` are sparse too; `dense` gives the problem with
+        arrays.
+    T_minus : float
+        Kinetic energy before the impact, ``v @ M @ v / 2`` (finite: checked).
+
     Raises
     ------
     InvalidProblem
@@ -344,6 +357,13 @@ class ImpactProblem:
     Wt: np.ndarray | None = None
     bodies: Mapping[str, Sequence[int]] = field(default_factory=dict)
     gaps: np.ndarray | None = None
+    # Found while the fields are checked and stored then by `__init__`: reading one is a
+    # dictionary look-up (a property's call costs more than a small impact's arithmetic).
+    n: int = field(init=False, repr=False)
+    m: int = field(init=False, repr=False)
+    d: int = field(init=False, repr=False)
+    sparse: bool = field(init=False, repr=False)
+    T_minus: float = field(init=False, repr=False)
 
     def __init__(
         self,
@@ -564,23 +584,6 @@ class ImpactProblem:
                 f" = {normal[j]:.3g}): a singular configuration"
             )
 
-    # The sizes are known once the problem is checked: `__init__` stores them, so that
-    # reading one is a dictionary look-up.
-    @cached_property
-    def n(self) -> int:
-        """Number of generalized coordinates."""
-        return self.v.shape[0]
-
-    @cached_property
-    def m(self) -> int:
-        """Number of contacts."""
-        return len(self.contacts)
-
-    @cached_property
-    def d(self) -> int:
-        """Tangential directions per contact: 0 without friction, 1 planar, 2 spatial."""
-        return 0 if self.Wt is None else self.Wt.shape[1] // self.m
-
     @cached_property
     def frictional(self) -> bool:
         """Whether some contact has a tangential Jacobian and a positive mu."""
@@ -607,11 +610,6 @@ class ImpactProblem:
         separating = self.closed & (self.un > SEPARATING * (scale or 1.0))
         return tuple(int(j) for j in np.flatnonzero(separating))
 
-    @cached_property
-    def T_minus(self) -> float:
-        """Kinetic energy before the impact, ``v @ M @ v / 2`` (finite: checked when built)."""
-        return self.kinetic_energy(self.v)
-
     def kinetic_energy(self, v: np.ndarray) -> float:
         """Kinetic energy ``v @ M @ v / 2`` of a velocity ``v`` (inf when it overflows).
 
@@ -623,15 +621,6 @@ class ImpactProblem:
         velocities = v.tolist()
         # x (m x), the products of numpy's v @ (M v).
         return sum(map(operator.mul, velocities, map(operator.mul, masses, velocities))) / 2.0
-
-    @cached_property
-    def sparse(self) -> bool:
-        """Whether M, Wn and Wt are scipy.sparse CSC arrays (a large problem given sparse).
-
-        Then `delassus`, `W` and `contact_delassus` are sparse too; `dense` gives the problem
-        with arrays.
-        """
-        return is_sparse(self.M)
 
     def dense(self) -> ImpactProblem:
         """The same problem with numpy arrays in place of sparse ones (itself when dense)."""
