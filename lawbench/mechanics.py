@@ -36,8 +36,7 @@ def velocity_after(
     problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
 ) -> np.ndarray:
     """Return ``v + M^-1 (Wn @ Pn + Wt @ Pt)``, the velocity after the impulses."""
-    impulse = problem.Wn.dot(Pn) if Pt is None else generalized_impulse(problem, Pn, Pt)
-    return problem.v + problem.solve_mass(impulse)
+    return problem.v + problem.solve_mass(generalized_impulse(problem, Pn, Pt))
 
 
 def gap_rates(problem: ImpactProblem, v: np.ndarray) -> np.ndarray:
