@@ -1,7 +1,7 @@
 """What the chain scenes share besides their problem: closed forms and their ground truth.
 
-`lawbench.chains` builds the problems; this module holds the references of free chains and the
-ground truth of every chain scene (compliant integration at the scene's stiffnesses).
+`lawbench.numerics.chains` builds the problems; this module holds the references of free chains and
+the ground truth of every chain scene (compliant integration at the scene's stiffnesses).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import GroundTruth, Reference
+from lawbench.core.case import GroundTruth, Reference
 
 SPRINGS = GroundTruth(
     why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from lawbench.case import GroundTruth
+from lawbench.core.case import GroundTruth
 
 
 def stronge(detail: str) -> GroundTruth:

@@ -17,8 +17,13 @@ from typing import Any
 import numpy as np
 from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
 
-from lawbench.case import CASES, Case, Params, per_item
-from lawbench.chains import (
+from lawbench.checks.declared import STUDIES, decades, extremes
+from lawbench.core.case import CASES, Case, Params, per_item
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.numerics.chains import (
     ball_velocities,
     chain_problem,
     exponent_spec,
@@ -27,12 +32,6 @@ from lawbench.chains import (
     restitution_spec,
     velocities_spec,
 )
-from lawbench.errors import InvalidProblem
-from lawbench.problem import ImpactProblem
-from lawbench.spec import Spec
-from lawbench.study import STUDIES
-from lawbench.study_shapes import decades, extremes
-from lawbench.tags import Tags
 
 
 class BallChain(Case):

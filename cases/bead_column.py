@@ -25,13 +25,12 @@ from typing import Any
 
 from lawbench.cases._chains import SPRINGS
 
-from lawbench.case import CASES, Case, Params, per_item
-from lawbench.chains import ball_velocities, chain_problem, restitution_spec
-from lawbench.problem import ImpactProblem
-from lawbench.spec import Spec
-from lawbench.study import STUDIES
-from lawbench.study_shapes import speed_accuracy
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES, speed_accuracy
+from lawbench.core.case import CASES, Case, Params, per_item
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.numerics.chains import ball_velocities, chain_problem, restitution_spec
 
 BEAD_MASS = 2.05e-3
 BEAD_STIFFNESS = 6.9716e9

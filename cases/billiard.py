@@ -40,15 +40,16 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, Params, Reference, per_item
-from lawbench.chains import exponent_spec, stiffness_ratio_spec
-from lawbench.checks import Trial
-from lawbench.errors import InvalidProblem
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.rigid import spatial_column
-from lawbench.spec import Spec
-from lawbench.study import STUDIES, Study
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES
+from lawbench.checks.study import Study
+from lawbench.core.case import CASES, Case, Params, Reference, per_item
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.core.trial import Trial
+from lawbench.numerics.chains import exponent_spec, stiffness_ratio_spec
+from lawbench.numerics.rigid import spatial_column
 
 TABLE_NORMAL = np.array([0.0, 0.0, 1.0])
 TABLE_TANGENTS = (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))

@@ -33,13 +33,12 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, GroundTruth, Params, Reference, exactly
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.rigid import spatial_column
-from lawbench.spec import Spec
-from lawbench.study import STUDIES
-from lawbench.study_shapes import large_friction
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES, large_friction
+from lawbench.core.case import CASES, Case, GroundTruth, Params, Reference, exactly
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.numerics.rigid import spatial_column
 
 # Jia's scenes are stated in his model: its tangential compliance at the scene's eta0^2.
 TANGENTIAL_COMPLIANCE = GroundTruth(

@@ -42,12 +42,11 @@ from lawbench.cases.bouncing_ball import (
     vector_spec,
 )
 
-from lawbench.case import CASES, Case, Params, exactly
-from lawbench.problem import ImpactProblem
-from lawbench.spec import Spec
-from lawbench.study import STUDIES
-from lawbench.study_shapes import large_friction
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES, large_friction
+from lawbench.core.case import CASES, Case, Params, exactly
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
 
 SPEED = 5.0
 DESCENT = math.pi / 6

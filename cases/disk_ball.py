@@ -49,14 +49,14 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, GroundTruth, Params, per_item
-from lawbench.chains import exponent_spec, stiffness_ratio_spec
-from lawbench.errors import InvalidProblem
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.spec import Spec
-from lawbench.study import STUDIES, Study
-from lawbench.study_shapes import impact_paths
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES, impact_paths
+from lawbench.checks.study import Study
+from lawbench.core.case import CASES, Case, GroundTruth, Params, per_item
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.numerics.chains import exponent_spec, stiffness_ratio_spec
 
 CONTACTS = ("A", "B", "C", "D")
 

@@ -47,19 +47,19 @@ from typing import Any
 import numpy as np
 from lawbench.cases._friction import stronge
 
-from lawbench.case import CASES, Case, Params, Reference, exactly
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.rigid import planar_column, planar_tangent
-from lawbench.spec import Spec
-from lawbench.study import STUDIES
-from lawbench.study_shapes import (
+from lawbench.checks.declared import (
+    STUDIES,
     duplicated_contact,
     energy_map,
     grazing,
     large_friction,
     speed_accuracy,
 )
-from lawbench.tags import Tags
+from lawbench.core.case import CASES, Case, Params, Reference, exactly
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.numerics.rigid import planar_column, planar_tangent
 
 FLOOR = np.array([0.0, 1.0])
 

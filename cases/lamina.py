@@ -30,17 +30,17 @@ from typing import Any
 import numpy as np
 from lawbench.cases._friction import stronge
 
-from lawbench.case import CASES, Case, Params, Reference
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.spec import Spec
-from lawbench.study import STUDIES
-from lawbench.study_shapes import (
+from lawbench.checks.declared import (
+    STUDIES,
     duplicated_contact,
     grazing,
     large_friction,
     speed_accuracy,
 )
-from lawbench.tags import Tags
+from lawbench.core.case import CASES, Case, Params, Reference
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
 
 _SOURCE = "Lubarda 2010 as given by Brogliato 2010, lamina on an anvil, eqs. (12)-(14)"
 

@@ -46,8 +46,11 @@ from typing import Any
 import numpy as np
 from lawbench.cases.two_balls_wall import TwoBallsWall
 
-from lawbench.case import CASES, Params
-from lawbench.chains import (
+from lawbench.checks.declared import STUDIES
+from lawbench.checks.study import Study
+from lawbench.core.case import CASES, Params
+from lawbench.core.spec import Spec
+from lawbench.numerics.chains import (
     ball_velocities,
     exponent_spec,
     gaps_spec,
@@ -55,8 +58,6 @@ from lawbench.chains import (
     stiffness_ratio_spec,
     velocities_spec,
 )
-from lawbench.spec import Spec
-from lawbench.study import STUDIES, Study
 
 # Jia, Mason, Erdmann (2013) as in Jia's 2012 talk: measured ball-ball and ball-table
 # coefficients, and the stiffness ratio k2/k1 they guessed.

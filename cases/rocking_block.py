@@ -45,14 +45,14 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.case import CASES, Case, GroundTruth, Params, Reference
-from lawbench.checks import Trial
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.rigid import planar_column, planar_tangent
-from lawbench.spec import Spec
-from lawbench.study import STUDIES, Study
-from lawbench.study_shapes import large_friction
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES, large_friction
+from lawbench.checks.study import Study
+from lawbench.core.case import CASES, Case, GroundTruth, Params, Reference
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.core.trial import Trial
+from lawbench.numerics.rigid import planar_column, planar_tangent
 
 FLOOR = np.array([0.0, 1.0])
 

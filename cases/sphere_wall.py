@@ -31,14 +31,14 @@ from typing import Any
 import numpy as np
 from lawbench.cases._friction import stronge
 
-from lawbench.case import CASES, Case, Params, Reference, exactly
-from lawbench.checks import Trial
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.rigid import spatial_column
-from lawbench.spec import Spec
-from lawbench.study import STUDIES, Study
-from lawbench.study_shapes import grazing, large_friction
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES, grazing, large_friction
+from lawbench.checks.study import Study
+from lawbench.core.case import CASES, Case, Params, Reference, exactly
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.core.trial import Trial
+from lawbench.numerics.rigid import spatial_column
 
 NORMAL = np.array([0.0, 1.0, 0.0])
 TANGENTS = (np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]))

@@ -14,8 +14,20 @@ from typing import Any
 import numpy as np
 from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
 
-from lawbench.case import CASES, Case, Params, Reference, exactly, per_item
-from lawbench.chains import (
+from lawbench.checks.declared import (
+    STUDIES,
+    continuity,
+    decades,
+    duplicated_contact,
+    energy_shares,
+    extremes,
+    grazing,
+    speed_accuracy,
+)
+from lawbench.core.case import CASES, Case, Params, Reference, exactly, per_item
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.tags import Tags
+from lawbench.numerics.chains import (
     ball_velocities,
     chain_problem,
     exponent_spec,
@@ -25,18 +37,6 @@ from lawbench.chains import (
     stiffness_ratio_spec,
     velocities_spec,
 )
-from lawbench.problem import ImpactProblem
-from lawbench.study import STUDIES
-from lawbench.study_shapes import (
-    continuity,
-    decades,
-    duplicated_contact,
-    energy_shares,
-    extremes,
-    grazing,
-    speed_accuracy,
-)
-from lawbench.tags import Tags
 
 
 def _equation_29(p: Params) -> np.ndarray:
@@ -86,6 +86,8 @@ class ThreeBallChain(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
+    # The smallest multiple impact: its start-up is the cost of the smallest command.
+    bench_roles = ("start_up",)
     ground_truth = SPRINGS
     references = (
         Reference(

@@ -16,8 +16,19 @@ from typing import Any
 import numpy as np
 from lawbench.cases._chains import SPRINGS
 
-from lawbench.case import CASES, Case, Params, Reference, exactly, per_item
-from lawbench.chains import (
+from lawbench.checks.declared import (
+    STUDIES,
+    continuity,
+    decades,
+    duplicated_contact,
+    energy_shares,
+    extremes,
+    grazing,
+)
+from lawbench.core.case import CASES, Case, Params, Reference, exactly, per_item
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.tags import Tags
+from lawbench.numerics.chains import (
     ball_velocities,
     chain_problem,
     exponent_spec,
@@ -27,17 +38,6 @@ from lawbench.chains import (
     stiffness_ratio_spec,
     velocities_spec,
 )
-from lawbench.problem import ImpactProblem
-from lawbench.study import STUDIES
-from lawbench.study_shapes import (
-    continuity,
-    decades,
-    duplicated_contact,
-    energy_shares,
-    extremes,
-    grazing,
-)
-from lawbench.tags import Tags
 
 
 def _unpack(p: Params) -> tuple[float, float, float, float, float]:

@@ -1,44 +1,60 @@
 """lawbench: compare the classical impact laws of rigid-body mechanics on shared scenes.
 
-The entry point is `solve` (or `evaluate`, which also keeps the problem and parameters for the
-checks): a law on a registered scene or on an `ImpactProblem` of your own. Laws and cases are
-in the registries `LAWS` and `CASES`; every check's result carries a `Verdict`. `fit`
-identifies a law's coefficients from measured pre- and post-impact velocities.
+The entry points share one convention, ``(law, scene name or problem, **params,
+options=...)``: `solve` returns the `Outcome`, `evaluate` the whole `Trial`, `run_checks` the
+verdict of every check (it also takes a trial alone). Laws, scenes and studies are in the
+read-only registries `LAWS`, `CASES` and ``lawbench.checks.declared.STUDIES``; every check's
+result carries a `Verdict`. `solve_batch` solves many problems of one shape, `fit` identifies
+a law's coefficients from measured velocities, `check_law` holds any law to the common checks,
+`load_problem` and `save_problem` read and write problem files, `load_run` reads a run table.
+
+The package is built in layers, each importing only those below it::
+
+    views      command line, report, figures           (lawbench.views)
+    studies    grids, runs, tables, baselines, fits    (lawbench.studies)
+    laws, cases                                          (lawbench.laws, lawbench.cases)
+    checks     checks, measures, regions, studies as data (lawbench.checks)
+    numerics, files                                      (lawbench.numerics, lawbench.files)
+    core       problem, outcome, law, case, registries, errors, verdicts (lawbench.core)
+
+This module only gathers the public names; nothing in the package imports it.
 """
 
 import importlib
 
-from lawbench.api import evaluate, solve, solve_batch
-from lawbench.case import CASES, Case, GroundTruth, Reference
-from lawbench.checks import CHECKS, CheckResult, Trial, run_checks
-from lawbench.errors import (
+from lawbench.checks import CHECKS, CheckResult, run_checks
+from lawbench.core.case import CASES, Case, GroundTruth, Reference
+from lawbench.core.errors import (
     BudgetExceeded,
     InvalidProblem,
     LawbenchError,
     NotApplicable,
     SolverFailure,
+    UnknownName,
 )
-from lawbench.law import LAWS, Law
-from lawbench.outcome import Outcome
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.spec import Spec
-from lawbench.tags import Tags
-from lawbench.verdicts import Claim, Region, Verdict
+from lawbench.core.law import LAWS, Law
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.core.trial import Trial, evaluate, solve, solve_batch
+from lawbench.core.verdicts import Claim, Region, Verdict
 
 # Loaded when first asked for: problem files need scipy.sparse (and h5py for HDF5), fitting
 # needs pandas and scipy.optimize, run tables pandas and pyarrow, figures matplotlib; batches
 # are more code than a single solve reads.
 _LAZY = {
-    "OutcomeBatch": "lawbench.batch",
-    "ProblemBatch": "lawbench.batch",
-    "load_problem": "lawbench.problem_files",
-    "save_problem": "lawbench.problem_files",
-    "fit": "lawbench.fitting",
-    "FitResult": "lawbench.fitting",
-    "load_run": "lawbench.runfile",
-    "plot_outcome": "lawbench.plotting",
-    "plot_path": "lawbench.plotting",
-    "plot_sweep": "lawbench.plotting",
+    "OutcomeBatch": "lawbench.core.batch",
+    "ProblemBatch": "lawbench.core.batch",
+    "load_problem": "lawbench.files.problem_files",
+    "save_problem": "lawbench.files.problem_files",
+    "fit": "lawbench.studies.fitting",
+    "FitResult": "lawbench.studies.fitting",
+    "load_run": "lawbench.studies.runfile",
+    "plot_outcome": "lawbench.views.plotting",
+    "plot_path": "lawbench.views.plotting",
+    "plot_sweep": "lawbench.views.plotting",
+    "check_law": "lawbench.studies.conformance",
 }
 
 
@@ -52,6 +68,11 @@ def __getattr__(name: str) -> object:
     if name in _LAZY:
         return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'lawbench' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    # The lazy names too, so that dir(), help() and completion show the whole public API.
+    return sorted({*globals(), *__all__})
 
 
 __all__ = [
@@ -79,7 +100,9 @@ __all__ = [
     "Spec",
     "Tags",
     "Trial",
+    "UnknownName",
     "Verdict",
+    "check_law",
     "evaluate",
     "fit",
     "load_problem",

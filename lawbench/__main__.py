@@ -2,6 +2,6 @@
 
 import sys
 
-from lawbench.cli import main
+from lawbench.views.cli import main
 
 sys.exit(main())

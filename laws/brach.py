@@ -46,15 +46,15 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.laws._claims import keeps_energy
 
-from lawbench.claims import keeps_energy
-from lawbench.errors import NotApplicable
-from lawbench.law import LAWS, Law
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.regions import coupled_friction
-from lawbench.tags import Tags
-from lawbench.verdicts import Claim
+from lawbench.checks.regions import coupled_friction
+from lawbench.core.errors import NotApplicable
+from lawbench.core.law import LAWS, Law
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.tags import Tags
+from lawbench.core.verdicts import Claim
 
 # Below this fraction of |un-| a slip velocity counts as zero.
 NO_SLIP = 1e-12
@@ -97,7 +97,7 @@ class Brach(Law):
         if un >= 0.0:
             diagnostics = {"formulation": "no impulse (the contact does not approach)"}
             return Outcome.from_impulses(problem, np.zeros(1), diagnostics=diagnostics)
-        e = float(problem.restitution("newton")[0])
+        e = float(problem.restitution("kinematic")[0])
         if problem.d == 0:
             Pn = -(1.0 + e) * un / problem.delassus[0, 0]
             diagnostics = {"formulation": "closed form (frictionless: Newton)"}

@@ -55,17 +55,17 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
+from lawbench.laws._claims import keeps_energy, never_creates_energy
 
-from lawbench import budget
-from lawbench.claims import keeps_energy, never_creates_energy
-from lawbench.errors import NotApplicable
-from lawbench.integrator import EventIntegrator
-from lawbench.law import LAWS, Law
-from lawbench.mechanics import for_products
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.spec import Spec
-from lawbench.tags import Tags
+from lawbench.core import budget
+from lawbench.core.errors import NotApplicable
+from lawbench.core.law import LAWS, Law
+from lawbench.core.mechanics import for_products
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.numerics.integrator import EventIntegrator
 
 MODELS = ("kelvin_voigt", "hertz", "hunt_crossley")
 DAMPING_RULES = {
@@ -192,7 +192,7 @@ class _Integration:
             if self.model == "kelvin_voigt"
             else np.array([c.exponent for c in contacts])
         )
-        self.e = problem.restitution("newton")
+        self.e = problem.restitution("kinematic")
         self.given_damping = np.array([c.damping for c in contacts])
         G = scipy.sparse.csc_array(problem.delassus)
         diagonal = G.diagonal()

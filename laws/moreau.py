@@ -38,18 +38,18 @@ impulse adds ``Pn_j un-_j / 2 > 0`` (``unilateral``) or ``(1 - e_j) Pn_j un-_j /
 energy. Neither choice is both admissible and dissipative on every scene; the checks
 ``admissible`` and ``energy_gain`` report which property fails.
 
-Formulations (``diagnostics['formulation']``). Without friction (no ``Wt``, or every
-``mu = 0``): closed form for one contact, decoupled for a diagonal Delassus matrix, the LCP in
-the impulses solved exactly by active-set enumeration up to ``ENUMERATION_MAX`` contacts
-(`lawbench.solvers.enumerate_lcp`; for one coefficient its solution is ``(1 + e)`` times the
-plastic projection's), and beyond that the cone projection (a QP in the velocities, solved with
-clarabel) for one coefficient when no closed contact separates, or the LCP in the impulses (a
-QP in ``Pn >= 0``, solved with clarabel) otherwise. With friction, the second-order cone QP in
-the impulses ``min P.G P / 2 + (q + s).P`` over the cones ``K_j`` (``G`` the contact Delassus
-matrix, ``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clarabel
-(`lawbench.cones`). A sparse problem (`ImpactProblem.sparse`, long chains) stays sparse on the
-frictionless path, from the Delassus matrix to clarabel and the polish's block solve, so a
-chain costs time linear in its length; with friction it is solved dense. Option ``friction``:
+Formulations (``diagnostics['formulation']``). Without friction (no ``Wt``, or every ``mu = 0``):
+closed form for one contact, decoupled for a diagonal Delassus matrix, the LCP in the impulses
+solved exactly by active-set enumeration up to ``ENUMERATION_MAX`` contacts
+(`lawbench.numerics.solvers.enumerate_lcp`; for one coefficient its solution is ``(1 + e)`` times
+the plastic projection's), and beyond that the cone projection (a QP in the velocities, solved with
+clarabel) for one coefficient when no closed contact separates, or the LCP in the impulses (a QP in
+``Pn >= 0``, solved with clarabel) otherwise. With friction, the second-order cone QP in the
+impulses ``min P.G P / 2 + (q + s).P`` over the cones ``K_j`` (``G`` the contact Delassus matrix,
+``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clarabel
+(`lawbench.numerics.cones`). A sparse problem (`ImpactProblem.sparse`, long chains) stays sparse on
+the frictionless path, from the Delassus matrix to clarabel and the polish's block solve, so a chain
+costs time linear in its length; with friction it is solved dense. Option ``friction``:
 
 - ``coulomb`` (default, "SOCP fixed point (clarabel)"): the exact law. Starting from
   ``s = 0``, each step fixes ``s_j = mu_j |ut+_j|`` from the previous solution and solves the
@@ -81,26 +81,27 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-
-from lawbench import budget, cones
-from lawbench.claims import (
+from lawbench.laws._claims import (
     PAOLI_DISCONTINUITY,
     RIGID_DISPERSION,
     keeps_energy,
     separating_held,
 )
-from lawbench.law import LAWS, Law
-from lawbench.mechanics import is_diagonal
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.regions import coupled_friction, option, separating_contact
-from lawbench.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
-from lawbench.spec import Spec
-from lawbench.tags import Tags
-from lawbench.verdicts import Claim
+
+from lawbench.checks.regions import coupled_friction, option, separating_contact
+from lawbench.core import budget
+from lawbench.core.law import LAWS, Law
+from lawbench.core.mechanics import is_diagonal
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.core.verdicts import Claim
+from lawbench.numerics import cones
+from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
 
 if TYPE_CHECKING:
-    from lawbench.batch import ProblemBatch
+    from lawbench.core.batch import ProblemBatch
 
 _SLIP_REVERSAL = (
     "kinematic restitution with Coulomb friction on the post-impact slip (at one contact "
@@ -124,6 +125,8 @@ class Moreau(Law):
     )
     tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="tol")
     takes_sparse = True
+    # Its frictionless impulses solve the LCP that clarabel and Siconos' Lemke are timed on.
+    bench_roles = ("lcp",)
 
     def rule_for_separating(self, options: dict[str, Any]) -> str:
         """The rule of option ``separating``."""
@@ -203,7 +206,7 @@ class Moreau(Law):
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
-        e, un = problem.restitution("newton"), problem.un
+        e, un = problem.restitution("kinematic"), problem.un
         if options["separating"] == "unilateral":
             restituted = np.minimum(un, 0.0)
         else:
@@ -244,7 +247,7 @@ class Moreau(Law):
             return None
         un = batch.un
         restituted = np.minimum(un, 0.0) if options["separating"] == "unilateral" else un
-        Pn, found = enumerate_lcp(batch.delassus, un + batch.restitution("newton") * restituted)
+        Pn, found = enumerate_lcp(batch.delassus, un + batch.restitution("kinematic") * restituted)
         if not found.all():
             return None
         return Pn, "LCP (active-set enumeration, batch)"

@@ -18,19 +18,19 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from lawbench.laws._claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 
-from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
-from lawbench.errors import NotApplicable
-from lawbench.law import LAWS, Law
-from lawbench.mechanics import is_diagonal
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.regions import separating_contact
-from lawbench.tags import Tags
-from lawbench.verdicts import Claim
+from lawbench.checks.regions import separating_contact
+from lawbench.core.errors import NotApplicable
+from lawbench.core.law import LAWS, Law
+from lawbench.core.mechanics import is_diagonal
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.tags import Tags
+from lawbench.core.verdicts import Claim
 
 if TYPE_CHECKING:
-    from lawbench.batch import ProblemBatch
+    from lawbench.core.batch import ProblemBatch
 
 _SOURCE = "Brogliato 2010, eq. (29) and the discussion of separating contacts after it"
 _ASKS_APPROACH = (
@@ -46,6 +46,8 @@ class Newton(Law):
     summary = "Newton's kinematic restitution at every closed contact at once"
     source = "Newton's law; generalized Newton law, Brogliato 2010, eq. (29)"
     tags = Tags(several_contacts=True)
+    # A closed form with no accuracy knob: its start-up is the cost of the smallest command.
+    bench_roles = ("start_up",)
     separating_rule = (
         "every closed contact is restituted, un+ = -e un-: a separating contact is asked "
         "to approach and may take a tensile impulse (tensile_contacts)"
@@ -78,7 +80,7 @@ class Newton(Law):
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         G = problem.delassus
-        change = -(1.0 + problem.restitution("newton")) * problem.un
+        change = -(1.0 + problem.restitution("kinematic")) * problem.un
         if is_diagonal(G):
             Pn = change / np.diag(G)
             formulation = "closed form" if problem.m == 1 else "decoupled (diagonal Delassus)"
@@ -96,7 +98,7 @@ class Newton(Law):
         self, batch: ProblemBatch, options: dict[str, Any]
     ) -> tuple[np.ndarray, str] | None:
         """``G Pn = -(1 + E) un-`` for every problem; dependent contacts go one by one."""
-        change = -(1.0 + batch.restitution("newton")) * batch.un
+        change = -(1.0 + batch.restitution("kinematic")) * batch.un
         Pn = _solve_independent(batch.delassus, change)
         return None if Pn is None else (Pn, "linear system (batch)")
 

@@ -23,18 +23,18 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from lawbench.laws._claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 
-from lawbench.claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
-from lawbench.law import LAWS, Law
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.regions import separating_contact
-from lawbench.solvers import ENUMERATION_MAX, enumerate_lcp, solve_lcp
-from lawbench.tags import Tags
-from lawbench.verdicts import Claim
+from lawbench.checks.regions import separating_contact
+from lawbench.core.law import LAWS, Law
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.tags import Tags
+from lawbench.core.verdicts import Claim
+from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, solve_lcp
 
 if TYPE_CHECKING:
-    from lawbench.batch import ProblemBatch
+    from lawbench.core.batch import ProblemBatch
 
 
 class Poisson(Law):
@@ -70,7 +70,7 @@ class Poisson(Law):
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
-        G, e = problem.delassus, problem.restitution("poisson")
+        G, e = problem.delassus, problem.restitution("kinetic")
         compression = solve_lcp(G, problem.un, method="nnls")
         restitution = e * compression.z
         expansion = solve_lcp(G, compression.w + G @ restitution, method="nnls")
@@ -87,7 +87,7 @@ class Poisson(Law):
         """Both complementarity problems by active-set enumeration, for every problem at once."""
         if batch.m > ENUMERATION_MAX:
             return None
-        G, e = batch.delassus, batch.restitution("poisson")
+        G, e = batch.delassus, batch.restitution("kinetic")
         compression, found = enumerate_lcp(G, batch.un)
         slack = np.einsum("kij,kj->ki", G, compression) + batch.un
         restitution = e * compression

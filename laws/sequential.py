@@ -25,14 +25,14 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.laws._claims import RIGID_DISPERSION, keeps_energy, never_creates_energy
 
-from lawbench import budget
-from lawbench.claims import RIGID_DISPERSION, keeps_energy, never_creates_energy
-from lawbench.law import LAWS, Law
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.spec import Spec
-from lawbench.tags import Tags
+from lawbench.core import budget
+from lawbench.core.law import LAWS, Law
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
 
 APPROACH_TOLERANCE = 1e-12
 RECORDED = 10_000
@@ -108,7 +108,7 @@ class _BinaryImpacts:
         self.problem = problem
         self.spend = budget.current()
         self.G = problem.delassus
-        self.e = problem.restitution("newton")
+        self.e = problem.restitution("kinematic")
         self.un = problem.un.copy()
         self.threshold = -APPROACH_TOLERANCE * np.abs(self.un).max()
         self.Pn = np.zeros(problem.m)

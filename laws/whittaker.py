@@ -76,22 +76,22 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
-
-from lawbench.claims import (
+from lawbench.laws._claims import (
     PAOLI_DISCONTINUITY,
     RIGID_DISPERSION,
     keeps_energy,
     separating_held,
 )
-from lawbench.errors import InvalidProblem, NotApplicable, SolverFailure
-from lawbench.law import LAWS, Law
-from lawbench.lemke import RayTermination, lemke
-from lawbench.mechanics import is_diagonal, kinetic_energy
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.regions import coupled_friction
-from lawbench.tags import Tags
-from lawbench.verdicts import Claim
+
+from lawbench.checks.regions import coupled_friction
+from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.law import LAWS, Law
+from lawbench.core.mechanics import is_diagonal, kinetic_energy
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.tags import Tags
+from lawbench.core.verdicts import Claim
+from lawbench.numerics.lemke import RayTermination, lemke
 
 # Largest number of planar contacts whose 4^m mode combinations are enumerated.
 MAX_ENUMERATED = 4
@@ -120,7 +120,7 @@ class _Setup:
     def of(cls, problem: ImpactProblem, friction: bool) -> _Setup:
         G = problem.contact_delassus if friction else problem.delassus
         un = problem.un
-        bias = un + problem.restitution("newton") * np.minimum(un, 0.0)
+        bias = un + problem.restitution("kinematic") * np.minimum(un, 0.0)
         if friction:
             bias = np.concatenate([bias, problem.ut])
         speed = max(float(np.abs(bias).max()), float(np.abs(un).max()), 1e-300)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.solvers import enumerate_lcp, solve_lcp
+from lawbench.numerics.solvers import enumerate_lcp, solve_lcp
 
 
 def random_chains(rng, count, balls):

@@ -85,7 +85,7 @@ def test_english_alone_runs_straight_and_a_masse_shot_curves():
     offset; a masse shot's tilted spin axis bends the path, the mirrored shot the other way."""
     from lawbench.cases.billiard import path_curvature
 
-    from lawbench.checks import Trial
+    from lawbench.core.trial import Trial
 
     def curvature(**params):
         params = CASE.parameters(**params)

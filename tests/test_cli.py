@@ -2,7 +2,7 @@
 
 Most calls run the command as a real subprocess (``python -m lawbench``, the same entry point
 as the console script); the exit codes that need a law to misbehave on purpose call
-`lawbench.cli.main` in the test process with a monkeypatched law.
+`lawbench.views.cli.main` in the test process with a monkeypatched law.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ from pathlib import Path
 import pytest
 
 import lawbench
-from lawbench import cli
 from lawbench.checks import SINGLE_SOLVE
+from lawbench.views import cli
 
 CONSOLE_SCRIPT = Path(sys.executable).parent / "lawbench"
 RECORD_KEYS = {
@@ -437,7 +437,7 @@ def test_small_commands_import_no_heavy_library(argv):
     """Laws register by name; an integrator, a table or plotting library loads on first use."""
     code = (
         "import contextlib, io, sys\n"
-        "from lawbench.cli import main\n"
+        "from lawbench.views.cli import main\n"
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         f"    main({argv!r})\n"
         f"print(sorted(m for m in sys.modules if m.split('.')[0] in {HEAVY!r} "
@@ -448,14 +448,14 @@ def test_small_commands_import_no_heavy_library(argv):
     assert done.stdout.strip() == "[]"
 
 
-@pytest.mark.parametrize("module", ["importlib.metadata", "lawbench.batch"])
+@pytest.mark.parametrize("module", ["importlib.metadata", "lawbench.core.batch"])
 def test_a_solve_of_built_in_entries_reads_no_metadata_and_no_batch_code(module):
     """A built-in law on a built-in scene needs no plugin lookup and no version: the package
     metadata (a third of the start-up) is read only for ``list``, plugins and ``--version``;
     nor does one solve read the batch module, compiled at every start without cached bytecode."""
     code = (
         "import contextlib, io, sys\n"
-        "from lawbench.cli import main\n"
+        "from lawbench.views.cli import main\n"
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         "    main(['solve', 'newton', 'three_ball_chain'])\n"
         f"print({module!r} in sys.modules)\n"

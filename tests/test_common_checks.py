@@ -1,13 +1,12 @@
 """Every registered law held to the common checks, one test per cell of `check_law`.
 
-The pattern of scikit-learn's common estimator checks, on `lawbench.testing` (the same cells
-`lawbench check LAW` prints): every check the law's tags make applicable, on every scene it
+The pattern of scikit-learn's common estimator checks, on `lawbench.studies.conformance` (the same
+cells `lawbench check LAW` prints): every check the law's tags make applicable, on every scene it
 can treat (each named example; continuity and dispersion on the defaults) and on seeded random
-chains. Every cell must end in a verdict a table may ship: *holds*, *refused* or *budget*
-(skipped with the reason), or *law property* (a failure the law's findings predict, run as an
-expected failure with the finding). A *numerical failure* or an *unexplained* verdict fails
-the test. Each finding is also held to its witnesses, so a finding that stops holding is
-noticed.
+chains. Every cell must end in a verdict a table may ship: *holds*, *refused* or *budget* (skipped
+with the reason), or *law property* (a failure the law's findings predict, run as an expected
+failure with the finding). A *numerical failure* or an *unexplained* verdict fails the test. Each
+finding is also held to its witnesses, so a finding that stops holding is noticed.
 """
 
 from functools import cache
@@ -15,8 +14,8 @@ from functools import cache
 import pytest
 
 import lawbench
-from lawbench.testing import cells, run_cell
-from lawbench.verdicts import Verdict
+from lawbench.core.verdicts import Verdict
+from lawbench.studies.conformance import cells, run_cell
 
 
 @cache
@@ -29,7 +28,7 @@ def trial(law_name, case_name, example):
         return str(refusal)
 
 
-ALL_CELLS = [(law, cell) for law in lawbench.LAWS for cell in cells(law)]
+ALL_CELLS = [(law, cell) for law in lawbench.LAWS.values() for cell in cells(law)]
 
 
 @pytest.mark.parametrize(("law", "cell"), ALL_CELLS, ids=[cell.id for _, cell in ALL_CELLS])
@@ -43,7 +42,7 @@ def test_common_check(law, cell):
 
 
 def witnesses():
-    for law in lawbench.LAWS:
+    for law in lawbench.LAWS.values():
         for claim in law.findings:
             for case, example in claim.witnesses:
                 yield pytest.param(
@@ -67,7 +66,7 @@ def test_every_finding_is_met_at_its_witnesses(law, claim, case, example):
 
 def first_scene(law_name):
     """The first case (by name) whose default example the law treats."""
-    for case in lawbench.CASES:
+    for case in lawbench.CASES.values():
         solved = trial(law_name, case.name, "default")
         if not isinstance(solved, str):
             return solved

@@ -230,7 +230,7 @@ def test_bead_column_wall_force_period_matches_falcon():
 def test_event_location_lands_just_past_the_sign_change():
     """Brent's method to rounding, then the first point on the new side: a state restarted
     there is on the new branch; a jump (no zero to converge to) is bisected to the same end."""
-    from lawbench.roots import crossing
+    from lawbench.numerics.roots import crossing
 
     smooth = crossing(lambda t: 0.3 - t, 0.0, 1.0)
     assert smooth > 0.3 and smooth - 0.3 < 1e-15

@@ -8,8 +8,8 @@ import pytest
 import lawbench
 from lawbench.checks.continuity import jumps
 from lawbench.checks.dispersion import dispersion_index
-from lawbench.events import resolve_with_gaps
-from lawbench.mechanics import energy_shares, kinetic_angles
+from lawbench.checks.gaps import resolve_with_gaps
+from lawbench.core.mechanics import energy_shares, kinetic_angles
 
 # Both contacts approach, so either can close first.
 HEAD_ON = {"velocities": [1.0, 0.0, -1.0], "e": [0.5]}

@@ -15,7 +15,7 @@ import pytest
 
 import lawbench
 from lawbench import Contact, ImpactProblem
-from lawbench.rigid import planar_column
+from lawbench.numerics.rigid import planar_column
 
 LAW = lawbench.LAWS.get("darboux_keller")
 NEWTON = lawbench.LAWS.get("newton")

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.fclib import read_fclib, write_fclib
+from lawbench.files.fclib import read_fclib, write_fclib
 
 h5py = pytest.importorskip("h5py")
 

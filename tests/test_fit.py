@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 
 import lawbench
-from lawbench.cli import main
-from lawbench.fitting import columns
+from lawbench.studies.fitting import columns
+from lawbench.views.cli import main
 
 COLUMNS = ["v1_minus", "v2_minus", "v1_plus", "v2_plus"]
 

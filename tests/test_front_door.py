@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import lawbench
-from lawbench.cli import main
+from lawbench.views.cli import main
 
 LAWS = lawbench.LAWS.names()
 CASES = lawbench.CASES.names()

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench import budget
-from lawbench.errors import BudgetExceeded
-from lawbench.integrator import EventIntegrator
+from lawbench.core import budget
+from lawbench.core.errors import BudgetExceeded
+from lawbench.numerics.integrator import EventIntegrator
 
 
 def harmonic(t: float, y: np.ndarray) -> np.ndarray:
@@ -101,7 +101,7 @@ def test_the_time_budget_stops_a_long_integration():
 
 def test_every_law_has_a_time_budget():
     """Every registered law declares ``max_seconds`` (given by the law protocol)."""
-    for law in lawbench.LAWS:
+    for law in lawbench.LAWS.values():
         assert "max_seconds" in [spec.name for spec in law.options], law.name
 
 
@@ -136,7 +136,9 @@ def test_every_step_budget_is_spent_through_the_solve_budget(name):
 def test_the_laws_with_a_step_budget_are_all_tested():
     """A law that declares max_steps joins the table above."""
     declared = {
-        law.name for law in lawbench.LAWS if any(s.name == "max_steps" for s in law.options)
+        law.name
+        for law in lawbench.LAWS.values()
+        if any(s.name == "max_steps" for s in law.options)
     }
     assert declared == set(STEPPING)
 

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from lawbench.laws.whittaker import planar_friction_lcp
 
-from lawbench.errors import InvalidProblem, SolverFailure
-from lawbench.lemke import RayTermination, lemke
-from lawbench.problem import Contact, ImpactProblem
+from lawbench.core.errors import InvalidProblem, SolverFailure
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.numerics.lemke import RayTermination, lemke
 
 
 def enumerate_solutions(M, q, tol=1e-9):

@@ -7,7 +7,7 @@ from lawbench.cases.bead_column import MEASURED_PEAK_FORCE, MEASURED_PERIOD
 
 import lawbench
 from lawbench import Contact, ImpactProblem
-from lawbench.rigid import planar_column, planar_tangent
+from lawbench.numerics.rigid import planar_column, planar_tangent
 
 LAW = lawbench.LAWS.get("lzb")
 STEEL_MASS, STEEL_STIFFNESS = 2.05e-3, 6.9716e9
@@ -155,7 +155,7 @@ def test_each_cycle_of_each_contact_obeys_stronges_coefficient(case, params, var
     lost is the sum over cycles of (1 - e*^2) W_c.
     """
     trial = lawbench.evaluate("lzb", case, {"variant": variant}, **params)
-    outcome, e = trial.outcome, trial.problem.restitution("energy")
+    outcome, e = trial.outcome, trial.problem.restitution("energetic")
     scale = outcome.T_minus
     lost = 0.0
     for j, contact_cycles in enumerate(outcome.diagnostics["cycles"]):
@@ -500,13 +500,14 @@ def test_a_contact_compressed_again_is_the_declared_frozen_configuration_finding
     the law's, and its dispersion verdict names that finding; where no contact is compressed
     again (a soft wall) the same check holds against the compliant ground truth.
     """
-    from lawbench.claims import FROZEN_CONFIGURATION
-    from lawbench.verdicts import Verdict
+    from lawbench.laws._claims import FROZEN_CONFIGURATION
+
+    from lawbench.core.verdicts import Verdict
 
     stiff = lawbench.evaluate(law, "two_balls_wall", stiffness_ratio=100.0)
     assert stiff.outcome.diagnostics["recompressed"] == [1]
-    result = lawbench.run_checks(stiff, ["dispersion"])["dispersion"]
+    result = lawbench.run_checks(stiff, checks=["dispersion"])["dispersion"]
     assert (result.verdict, result.claim) == (Verdict.LAW_PROPERTY, FROZEN_CONFIGURATION)
     soft = lawbench.evaluate(law, "two_balls_wall", stiffness_ratio=0.01, exponent=1.0)
     assert soft.outcome.diagnostics["recompressed"] == []
-    assert lawbench.run_checks(soft, ["dispersion"])["dispersion"].verdict is Verdict.HOLDS
+    assert lawbench.run_checks(soft, checks=["dispersion"])["dispersion"].verdict is Verdict.HOLDS

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench import cones
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.solvers import solve_lcp
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.numerics import cones
+from lawbench.numerics.solvers import solve_lcp
 
 SEEDS = range(12)
 MOREAU = lawbench.LAWS.get("moreau")
@@ -53,7 +53,7 @@ def restituted(problem, separating="unilateral"):
     """``E r``: the restitution term of the normal law."""
     un = problem.un
     r = np.minimum(un, 0.0) if separating == "unilateral" else un
-    return problem.restitution("newton") * r
+    return problem.restitution("kinematic") * r
 
 
 def cone_qp_cvxpy(problem, shift):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.verdicts import Verdict
+from lawbench.core.verdicts import Verdict
 
 
 def two_balls_and_a_wall(e=0.9, mu=None):

@@ -7,7 +7,7 @@ import pytest
 from scipy.optimize import least_squares
 
 import lawbench
-from lawbench.problem import ImpactProblem
+from lawbench.core.problem import ImpactProblem
 
 CASE = lawbench.CASES.get("ping_pong")
 LAWS = ("jia", "lzb")

@@ -8,7 +8,7 @@ import matplotlib
 import pytest
 
 import lawbench
-from lawbench.report.plots import law_style
+from lawbench.views.report.plots import law_style
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -23,7 +23,7 @@ def ax():
 
 @pytest.fixture(scope="module")
 def run_table(tmp_path_factory):
-    from lawbench.cli import main
+    from lawbench.views.cli import main
 
     out = tmp_path_factory.mktemp("sweep") / "e.parquet"
     args = ["run", "--laws", "newton,moreau", "--cases", "three_ball_chain", "--param"]
@@ -47,9 +47,9 @@ def test_plot_outcome_draws_bars_before_and_after_named_by_coordinate(ax):
     assert heights[3:] == pytest.approx(list(trial.outcome.v_plus))
 
 
-def test_an_outcome_plots_itself_with_its_pre_impact_velocity(ax):
+def test_plot_outcome_of_an_outcome_draws_its_pre_impact_velocity(ax):
     outcome = lawbench.solve("newton", "three_ball_chain", e=1)
-    assert outcome.plot(ax=ax) is ax
+    assert lawbench.plot_outcome(outcome, ax=ax) is ax
     assert [p.get_height() for p in ax.patches][:3] == pytest.approx([1.0, 0.0, 0.0])
     assert ax.get_ylabel() == "velocity"
     assert [t.get_text() for t in ax.get_xticklabels()] == ["q1", "q2", "q3"]
@@ -94,7 +94,6 @@ def test_without_axes_each_draws_on_a_new_figure(run_table):
     outcome = lawbench.solve("lzb", "three_ball_chain", {"path": True})
     drawn = [
         lawbench.plot_outcome(outcome),
-        outcome.plot(),
         lawbench.plot_path(outcome),
         lawbench.plot_sweep(run_table, "e", "dT"),
     ]

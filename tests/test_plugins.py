@@ -31,7 +31,7 @@ class Mirror(lawbench.Law):
     tags = lawbench.Tags()
 
     def _resolve(self, problem, options):
-        Pn = -(1 + problem.restitution("newton")) * problem.un / np.diag(problem.delassus)
+        Pn = -(1 + problem.restitution("kinematic")) * problem.un / np.diag(problem.delassus)
         return lawbench.Outcome.from_impulses(problem, np.maximum(Pn, 0.0),
                                               diagnostics={"formulation": "closed form"})
 
@@ -146,8 +146,8 @@ def test_a_new_law_and_scene_need_no_baseline_edit(plugin_env):
 
 REPORT = """
 import dataclasses, pathlib, sys
-from lawbench.report import write_report
-from lawbench.report.config import QUICK
+from lawbench.views.report import write_report
+from lawbench.views.report.config import QUICK
 
 config = dataclasses.replace(QUICK, laws=("mirror", "newton"), cases=("ball_on_wall",), workers=1)
 write_report(pathlib.Path(sys.argv[1]), config=config)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.problem_files import load_problem, save_problem
+from lawbench.files.problem_files import load_problem, save_problem
 
 ENCODINGS = (".json", ".npz", ".h5")
 # The integrating laws cost seconds a solve: their round trip is checked on the defaults.
@@ -16,7 +16,7 @@ SLOW = {"compliant", "lzb", "jia", "darboux_keller"}
 
 
 def examples():
-    for case in lawbench.CASES:
+    for case in lawbench.CASES.values():
         for example in case.examples:
             yield pytest.param(case.name, example, id=f"{case.name}-{example}".replace(" ", "_"))
 
@@ -38,7 +38,7 @@ def test_every_scene_round_trips_to_an_identical_problem_and_outcomes(case, exam
     for suffix in ENCODINGS:
         loaded = load_problem(save_problem(problem, tmp_path / f"p{suffix}"))
         same_problem(problem, loaded)
-        for law in lawbench.LAWS:
+        for law in lawbench.LAWS.values():
             if law.name in SLOW and example != next(iter(scene.examples)):
                 continue
             try:

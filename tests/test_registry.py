@@ -6,7 +6,7 @@ import types
 import pytest
 
 import lawbench
-from lawbench.registry import Registry
+from lawbench.core.registry import Registry
 
 
 def test_the_shipped_laws_and_cases_are_registered():

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 
 import lawbench
-from lawbench.baselines import BASELINES, load, regress
+from lawbench.studies.baselines import BASELINES, load, regress
 
 
 def test_regress_passes_on_the_committed_baselines():

@@ -16,14 +16,15 @@ import pandas as pd
 import pytest
 
 import lawbench
-from lawbench.report import QUICK, write_report
-from lawbench.report.inside import QUANTITIES
-from lawbench.report.marks import Mark
-from lawbench.report.outcomes import _figure as outcomes_figure
-from lawbench.report.page import Figure, Legend, Section, Table, write_page
-from lawbench.report.plots import figure
-from lawbench.report.tradeoff import pareto
-from lawbench.verdicts import Verdict
+from lawbench.checks.declared import STUDIES
+from lawbench.core.verdicts import Verdict
+from lawbench.views.report import QUICK, write_report
+from lawbench.views.report.inside import QUANTITIES
+from lawbench.views.report.marks import Mark
+from lawbench.views.report.outcomes import _figure as outcomes_figure
+from lawbench.views.report.page import Figure, Legend, Section, Table, write_page
+from lawbench.views.report.plots import figure
+from lawbench.views.report.tradeoff import pareto
 
 SECTIONS = ("summary", "outcomes", "tradeoff", "stability", "paradoxes", "dispersion", "inside")
 CLOSED_FORM = ("newton", "poisson", "sequential", "moreau")
@@ -240,7 +241,7 @@ def _answered(tables: dict[str, pd.DataFrame], names) -> pd.DataFrame:
 
 def test_the_stability_grid_has_no_nan_and_no_time_out(report):
     tables = runs(report)
-    stability = [s.name for s in lawbench.study.STUDIES if s.view == "stability"]
+    stability = [s.name for s in STUDIES.values() if s.view == "stability"]
     cells = pd.concat([tables[n] for n in stability if n in tables], ignore_index=True)
     assert set(cells["verdict"]) <= CLASSES
     budget = cells[cells["verdict"] == "budget"]
@@ -416,7 +417,7 @@ def test_the_quick_report_end_to_end(quick):
 @pytest.mark.slow
 def test_the_quick_stability_grid_has_no_nan_and_no_time_out(quick):
     tables = runs(quick[0])
-    stability = [s.name for s in lawbench.study.STUDIES if s.view == "stability"]
+    stability = [s.name for s in STUDIES.values() if s.view == "stability"]
     cells = pd.concat([tables[n] for n in stability if n in tables], ignore_index=True)
     assert set(cells["verdict"]) <= CLASSES
     assert not (cells["error_class"].fillna("") == "WorkerDied").any()
@@ -429,10 +430,10 @@ def test_a_path_study_along_a_parameter_draws_each_cell_side_by_side():
     at three impact heights, one panel per height on a shared energy axis; the energy of a
     contact is never negative and ends at zero (every spring relaxes when the impact ends);
     struck high, the primary contact passes from the ball D to the floor's far point C."""
-    from lawbench.report.inside import _along
-    from lawbench.runner import Executor, collect
+    from lawbench.studies.runner import Executor, collect
+    from lawbench.views.report.inside import _along
 
-    study = lawbench.study.STUDIES.get("disk_ball_energies")
+    study = STUDIES.get("disk_ball_energies")
     with Executor() as pool:
         table = collect(study.plan(), pool)
     drawn = _along(lawbench.CASES.get("disk_ball"), study, table)

@@ -103,7 +103,7 @@ WITHOUT_EXTRAS = """
 import sys
 for name in ("dask", "distributed", "h5py", "cvxpy", "hypothesis"):
     sys.modules[name] = None
-from lawbench.cli import main
+from lawbench.views.cli import main
 sys.exit(main(sys.argv[1:]))
 """
 

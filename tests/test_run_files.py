@@ -11,9 +11,9 @@ import pandas as pd
 import pytest
 
 import lawbench
-from lawbench.runfile import Store
-from lawbench.runner import Task, compute, run
-from lawbench.study import Job, Plan
+from lawbench.checks.study import Job, Plan
+from lawbench.studies.runfile import Store
+from lawbench.studies.runner import Task, compute, run
 
 GRID = [
     "--laws",
@@ -88,7 +88,7 @@ def test_a_truncated_chunk_is_reported_and_computed_again(tmp_path, caplog):
         store.write_chunk([compute(Task(index, job))])
     first = store.chunks()[0]
     first.write_bytes(first.read_bytes()[:100])
-    with caplog.at_level(logging.WARNING, logger="lawbench.runner"):
+    with caplog.at_level(logging.WARNING, logger="lawbench.studies.runner"):
         table, computed = run(plan, tmp_path / "out.parquet", resume=True)
     assert computed == 2  # the damaged chunk's cell and the missing one
     assert "part-000000.parquet is damaged (checksum mismatch)" in caplog.text

@@ -14,9 +14,9 @@ import pyarrow.parquet as pq
 import pytest
 
 import lawbench
-from lawbench.grid import RunSpec, parse_values
-from lawbench.runner import _progress
-from lawbench.verdicts import Verdict
+from lawbench.core.verdicts import Verdict
+from lawbench.studies.grid import RunSpec, parse_values
+from lawbench.studies.runner import _progress
 
 CHAIN = ["--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial"]
 
@@ -115,7 +115,8 @@ def test_a_grid_of_a_hundred_million_cells_is_refused_before_it_is_built(
 ):
     """Counted from the grid's sizes: no row is built, no generator drawn whole, and the
     memory taken stays far below what 10^7 grid points alone would take (80 MB as floats)."""
-    from lawbench import cli, grid
+    from lawbench.studies import grid
+    from lawbench.views import cli
 
     def built(*args):
         pytest.fail("the grid was built")
@@ -183,7 +184,7 @@ def test_the_count_and_the_sample_agree_with_the_rows(data):
     ],
 )
 def test_a_grid_point_computed_alone_is_the_same_as_in_the_whole_list(generator):
-    from lawbench.grid import Generated
+    from lawbench.studies.grid import Generated
 
     points = Generated(generator, 7, (0, "param", "e"))
     whole = list(points)

@@ -8,13 +8,13 @@ import pandas as pd
 import pytest
 
 import lawbench
-from lawbench.grid import RunSpec, values
-from lawbench.guard import Guard
-from lawbench.record import budget_text
-from lawbench.runfile import untidy
-from lawbench.runner import Executor, Task, compute, run, run_many
-from lawbench.study import Job, Plan
-from lawbench.transforms import apply, parse, spell
+from lawbench.checks.study import Job, Plan
+from lawbench.numerics.transforms import apply, parse, spell
+from lawbench.studies.grid import RunSpec, values
+from lawbench.studies.guard import Guard
+from lawbench.studies.record import budget_text
+from lawbench.studies.runfile import untidy
+from lawbench.studies.runner import Executor, Task, compute, run, run_many
 
 SPEC = {
     "seed": 3,

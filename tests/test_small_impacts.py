@@ -14,7 +14,7 @@ import pytest
 
 import lawbench
 from lawbench import Contact, ImpactProblem, InvalidProblem
-from lawbench.solvers import _enumerate_sets, clarabel_qp, enumerate_lcp, polish, solve_lcp
+from lawbench.numerics.solvers import _enumerate_sets, clarabel_qp, enumerate_lcp, polish, solve_lcp
 
 
 def random_lcps(rng, count, m, decades=2.0):

@@ -6,9 +6,9 @@ import scipy.sparse
 
 import lawbench
 from lawbench import Contact, ImpactProblem, InvalidProblem
-from lawbench.chains import SPARSE_CONTACTS
-from lawbench.problem import SMALL
-from lawbench.problem_files import load_problem, save_problem
+from lawbench.core.problem import SMALL
+from lawbench.files.problem_files import load_problem, save_problem
+from lawbench.numerics.chains import SPARSE_CONTACTS
 
 
 def random_chain(seed, sparse, banded=False):

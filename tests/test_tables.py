@@ -15,9 +15,10 @@ import pytest
 from lawbench.cases.rocking_block import housner_ratio
 
 import lawbench
-from lawbench.study import STUDIES, Study
-from lawbench.tables import Table, study_table
-from lawbench.verdicts import Verdict
+from lawbench.checks.declared import STUDIES
+from lawbench.checks.study import Study
+from lawbench.core.verdicts import Verdict
+from lawbench.studies.tables import Table, study_table
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +45,7 @@ def test_every_declared_study_expands_into_valid_cells():
     """Every study's grid is checked against its scenes and laws (an error names the study)."""
     names = STUDIES.names()
     assert {"rocking_block", "sphere_wall", "dispersion", "summary"} <= set(names)
-    for study in STUDIES:
+    for study in STUDIES.values():
         for mode in ("quick", "full"):
             jobs = list(study.preset(mode).jobs())
             assert jobs, study.name
@@ -151,7 +152,7 @@ def test_failed_cells_are_notes_once_per_law_and_reason():
         grid={"e": [[0.0], [0.5], [0.0, 0.5]]},
         options={"sequential": {"max_steps": [5]}},
     )
-    from lawbench.runner import Executor, collect
+    from lawbench.studies.runner import Executor, collect
 
     with Executor() as pool:
         table = Table(study, collect(study.plan(), pool))
@@ -185,7 +186,7 @@ def test_the_command_writes_the_table_and_prints_the_view(tmp_path):
 def test_a_study_is_written_in_the_tidy_format_of_a_run(tmp_path, suffix):
     """One writer for runs and studies: typed parameter columns, list columns for the vectors
     (and the vector parameter ``spin``), categorical verdicts, the study in the metadata."""
-    from lawbench.cli import main
+    from lawbench.views.cli import main
 
     out = tmp_path / f"sphere{suffix}"
     assert main(["study", "sphere_wall", "--set", "angle=30", "--out", str(out)]) == 0
@@ -203,7 +204,8 @@ def test_a_study_is_written_in_the_tidy_format_of_a_run(tmp_path, suffix):
 
 
 def test_a_study_refuses_an_unknown_extension_before_any_work(tmp_path, capsys, monkeypatch):
-    from lawbench import cli, tables
+    from lawbench.studies import tables
+    from lawbench.views import cli
 
     monkeypatch.setattr(tables, "study_table", lambda *a, **k: pytest.fail("the study ran"))
     out = tmp_path / "sphere.txt"
@@ -222,16 +224,13 @@ def test_table_is_study_and_list_names_every_study():
     assert result.stderr.count("\n") == 1 and "unknown study 'nope'" in result.stderr
 
 
-ENGINE = ("study.py", "study_shapes.py", "runner.py", "record.py", "measures.py", "tables.py")
-ENGINE += ("transforms.py", "guard.py", "grid.py", "chains.py")
-
-
-def test_the_study_engine_and_the_report_name_no_law_or_scene():
-    """Studies, views and their shapes learn laws and scenes from the registries and from
-    the data declared with them; a name may appear in a docstring only."""
+def test_the_engine_names_no_law_or_scene():
+    """Every module of lawbench/ (core, numerics, files, checks, studies, views) learns laws
+    and scenes from the registries and from the data declared with them; a name may appear in
+    a docstring only."""
     root = Path(lawbench.__file__).parent
     names = set(lawbench.LAWS.names()) | set(lawbench.CASES.names())
-    paths = [root / name for name in ENGINE] + sorted((root / "report").glob("*.py"))
+    paths = sorted(root.rglob("*.py"))
     hits = []
     for path in paths:
         tree = ast.parse(path.read_text())
@@ -244,7 +243,7 @@ def test_the_study_engine_and_the_report_name_no_law_or_scene():
             and isinstance(node.body[0].value, ast.Constant)
         }
         hits += [
-            f"{path.name}:{node.lineno} {node.value!r}"
+            f"{path.relative_to(root)}:{node.lineno} {node.value!r}"
             for node in ast.walk(tree)
             if isinstance(node, ast.Constant) and node.value in names and id(node) not in docs
         ]
@@ -254,8 +253,8 @@ def test_the_study_engine_and_the_report_name_no_law_or_scene():
 def test_a_sweep_draws_each_measure_against_its_axis_per_law():
     """The billiard sweep: one row per answered cell with the elevation and every numeric
     measure (the spin vector expanded), one panel per measure, one line per law."""
-    from lawbench.report import sweeps
-    from lawbench.runner import Executor, collect
+    from lawbench.studies.runner import Executor, collect
+    from lawbench.views.report import sweeps
 
     study = STUDIES.get("billiard")
     with Executor() as pool:
@@ -280,7 +279,7 @@ def test_a_sweep_draws_each_measure_against_its_axis_per_law():
 def test_every_sweep_states_the_unit_of_what_it_draws():
     """Each panel of a sweep holds one quantity with its unit: the study declares a unit for
     every measure it draws, and its abscissa is a scene parameter with a unit."""
-    for study in STUDIES:
+    for study in STUDIES.values():
         if study.view != "sweep":
             continue
         drawn = list(study.axes[1:]) or list(study.measures)
@@ -291,8 +290,8 @@ def test_every_sweep_states_the_unit_of_what_it_draws():
 
 def test_a_sweep_over_decades_draws_a_log_abscissa():
     """ping_pong over k2/k1 from 1/10 to 10: a log abscissa, dimensionless rebound ratios."""
-    from lawbench.report import sweeps
-    from lawbench.runner import Executor, collect
+    from lawbench.studies.runner import Executor, collect
+    from lawbench.views.report import sweeps
 
     study = STUDIES.get("ping_pong").with_params({}).preset("quick")
     study = dataclasses.replace(study, laws=("sequential",))

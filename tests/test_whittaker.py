@@ -18,9 +18,9 @@ import scipy.optimize
 from lawbench.laws.whittaker import MAX_ENUMERATED
 
 import lawbench
-from lawbench.errors import NotApplicable, SolverFailure
-from lawbench.problem import Contact, ImpactProblem
-from lawbench.rigid import spatial_column
+from lawbench.core.errors import NotApplicable, SolverFailure
+from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.numerics.rigid import spatial_column
 
 LAW = lawbench.LAWS.get("whittaker")
 
@@ -84,7 +84,7 @@ def law_violation(problem, Pn, Pt):
     """Largest relative violation of the law's conditions by the impulses (Pn, Pt)."""
     Pt = np.reshape(Pt, (problem.m, -1))
     _, un_plus, ut_plus = post_rates(problem, Pn, Pt.ravel())
-    e, mu = problem.restitution("newton"), problem.mu
+    e, mu = problem.restitution("kinematic"), problem.mu
     V = max(np.abs(problem.un).max(), np.abs(problem.ut).max())
     P = max(np.abs(Pn).max(), np.abs(Pt).max(), V / problem.contact_delassus.diagonal().max())
     gap = un_plus + e * np.minimum(problem.un, 0.0)
@@ -118,7 +118,7 @@ def mode_system(problem, modes):
     (gap = 0, Pt = mu Pn); the gap is ``un+ + e min(un-, 0)``.
     """
     m, G = problem.m, problem.contact_delassus
-    e, mu, un, ut = problem.restitution("newton"), problem.mu, problem.un, problem.ut
+    e, mu, un, ut = problem.restitution("kinematic"), problem.mu, problem.un, problem.ut
     bias = np.concatenate([un + e * np.minimum(un, 0.0), ut])
     eye = np.eye(2 * m)
     A, b, C, d = [], [], [], []
@@ -194,7 +194,7 @@ def scan_spatial(problem, samples=20_000):
     refined with brentq.
     """
     G, mu = problem.contact_delassus, problem.mu[0]
-    e, un, ut = problem.restitution("newton")[0], problem.un[0], problem.ut
+    e, un, ut = problem.restitution("kinematic")[0], problem.un[0], problem.ut
     c = -(un + e * min(un, 0.0))
 
     def state(theta):

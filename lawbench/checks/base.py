@@ -2,49 +2,27 @@
 
 A check function reads a `Trial` and returns ``(value, passed, detail)``: ``passed`` None when
 the check does not apply (the detail says why). `run_checks` turns that raw result into a
-verdict of the taxonomy (`lawbench.verdicts`) from the law's findings and guarantees.
+verdict of the taxonomy (`lawbench.core.verdicts`) from the law's findings and guarantees.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from lawbench.case import Case
-from lawbench.law import Law
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.verdicts import Claim, Verdict, judge
+from lawbench.core.case import Case
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.law import Law
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.trial import Trial, evaluate
+from lawbench.core.verdicts import Claim, Verdict
 
 if TYPE_CHECKING:
     import pandas as pd
 
 # Relative tolerance of the verdicts: a law that is exact must pass them to rounding.
 TOLERANCE = 1e-9
-
-
-@dataclass(frozen=True)
-class Trial:
-    """One law solved on one problem: everything a check may read.
-
-    ``case`` and ``params`` are the scene and its complete parameters when the problem was
-    built from a registered scene; None and empty for a problem given as it is.
-    """
-
-    law: Law
-    case: Case | None
-    params: dict[str, Any]
-    options: dict[str, Any]
-    problem: ImpactProblem
-    outcome: Outcome
-    # Settings of the checks that solve again (for example continuity's perturbation sizes).
-    settings: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def scene(self) -> str:
-        """The scene's name, or 'problem' for a problem given as it is."""
-        return self.case.name if self.case is not None else "problem"
 
 
 @dataclass(frozen=True)
@@ -105,6 +83,35 @@ class CheckResults(dict[str, CheckResult]):
         return self.to_frame().to_html(index=False)
 
 
+def judge(trial: Trial, check: str, passed: bool | None, promised: bool) -> tuple[Verdict, Any]:
+    """The verdict of a check's raw result on ``trial``, and the claim that decided it.
+
+    Parameters
+    ----------
+    trial : Trial
+        The solve the check read.
+    check : str
+        The check's name.
+    passed : bool or None
+        The check's result; None when it does not apply.
+    promised : bool
+        Whether every law promises this check everywhere.
+    """
+    if passed is None:
+        return Verdict.REFUSED, None
+    if passed:
+        return Verdict.HOLDS, None
+    for claim in trial.law.findings:
+        if claim.check == check and claim.region(trial):
+            return Verdict.LAW_PROPERTY, claim
+    for claim in trial.law.guarantees:
+        if claim.check == check and claim.region(trial):
+            return Verdict.NUMERICAL_FAILURE, claim
+    if promised:
+        return Verdict.NUMERICAL_FAILURE, None
+    return Verdict.UNEXPLAINED, None
+
+
 Check = Callable[[Trial], CheckResult]
 CHECKS: dict[str, Check] = {}
 # The checks that read the one outcome of a trial; the others solve the problem again.
@@ -137,6 +144,77 @@ def check(
     return register
 
 
-def run_checks(trial: Trial, names: list[str] | None = None) -> CheckResults:
-    """Run the named checks on ``trial`` (by default every single-solve check), in order."""
-    return CheckResults({name: CHECKS[name](trial) for name in names or SINGLE_SOLVE})
+def run_checks(
+    law: str | Law | Trial,
+    case: str | Case | ImpactProblem | None = None,
+    options: Mapping[str, Any] | None = None,
+    *,
+    checks: str | Sequence[str] | None = None,
+    **params: Any,
+) -> CheckResults:
+    """Solve ``law`` on a scene or a problem, as `lawbench.solve` does, and run the checks.
+
+    Parameters
+    ----------
+    law : str, Law or Trial
+        A registered law name or a law object; or a trial already solved (`lawbench.evaluate`),
+        given alone.
+    case : str, Case or ImpactProblem
+        A registered scene name, a scene object, or an impact problem of your own.
+    options : mapping, optional
+        The law's options.
+    checks : str or sequence of str, optional
+        The checks to run, in order; by default every single-solve check.
+    **params
+        The scene's parameters; the others take their defaults.
+
+    Returns
+    -------
+    CheckResults
+        Check name -> result.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type, or a trial given with a scene, options or parameters.
+    InvalidProblem
+        An unknown check, or what `lawbench.solve` raises for bad input.
+
+    Examples
+    --------
+    >>> import lawbench
+    >>> results = lawbench.run_checks("newton", "three_ball_chain", e=0.5)
+    >>> str(results["energy_gain"].verdict)
+    'holds'
+    """
+    if isinstance(law, Trial):
+        given = {"case": case, "options": options, **params}
+        extra = {name: value for name, value in given.items() if value is not None}
+        if extra:
+            name, value = next(iter(extra.items()))
+            raise TypeError(
+                f"run_checks() takes a trial alone, but {name} was given with it ({value!r}); "
+                "name the checks with checks=[...]"
+            )
+        trial = law
+    elif case is None:
+        raise TypeError(
+            "run_checks() needs the argument case (a scene name, a Case or an ImpactProblem) "
+            "with a law, or a trial alone"
+        )
+    else:
+        trial = evaluate(law, case, options, **params)
+    return CheckResults({name: CHECKS[name](trial) for name in _check_names(checks)})
+
+
+def _check_names(checks: object) -> list[str]:
+    """The argument ``checks`` as a list of known check names (every single-solve one if None)."""
+    if checks is None:
+        return list(SINGLE_SOLVE)
+    names = [checks] if isinstance(checks, str) else checks
+    if not isinstance(names, Sequence) or not all(isinstance(n, str) for n in names):
+        raise TypeError(f"checks must be a check name or a sequence of them, not {checks!r}")
+    unknown = [name for name in names if name not in CHECKS]
+    if unknown:
+        raise InvalidProblem(f"unknown check {unknown[0]!r}; known: {', '.join(CHECKS)}")
+    return list(names)

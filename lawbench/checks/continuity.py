@@ -6,7 +6,7 @@ of ``settings['continuity_sizes']`` (default 1e-2, 1e-4, 1e-6), relative to the 
 scales: gaps relative to the largest contact indentation of the impact (`indentation_scale`, so
 that a gap vanishes against the deformation a compliant contact resolves, steel beads indenting
 by micrometres included), velocity changes relative to the largest velocity. A rigid law meets
-the gaps event by event (`lawbench.events.resolve_with_gaps`). The value is the outcome jump
+the gaps event by event (`lawbench.checks.gaps.resolve_with_gaps`). The value is the outcome jump
 that remains at the smallest size, relative to the largest velocity; continuous when it is
 below 1e-3. The detail gives the jumps per size and the kinetic angles between the contacts,
 which by Paoli's condition (Brogliato 2010, 'kinetic angle and continuity') predict where rigid
@@ -19,11 +19,12 @@ import dataclasses
 
 import numpy as np
 
-from lawbench.checks.base import Trial, check
-from lawbench.errors import LawbenchError
-from lawbench.events import resolve_with_gaps
-from lawbench.mechanics import kinetic_angles
-from lawbench.problem import ImpactProblem
+from lawbench.checks.base import check
+from lawbench.checks.gaps import resolve_with_gaps
+from lawbench.core.errors import LawbenchError
+from lawbench.core.mechanics import kinetic_angles
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.trial import Trial
 
 SIZES = (1e-2, 1e-4, 1e-6)
 CONTINUOUS = 1e-3

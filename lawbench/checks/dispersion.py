@@ -15,10 +15,11 @@ import math
 
 import numpy as np
 
-from lawbench.checks.base import Trial, check
-from lawbench.errors import LawbenchError
-from lawbench.law import LAWS
-from lawbench.mechanics import energy_shares
+from lawbench.checks.base import check
+from lawbench.core.errors import LawbenchError
+from lawbench.core.law import LAWS
+from lawbench.core.mechanics import energy_shares
+from lawbench.core.trial import Trial
 
 AGREEMENT = 0.05
 

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from lawbench.checks.base import TOLERANCE, Trial, check
-from lawbench.mechanics import gap_rates
-from lawbench.problem import RESTITUTION_KINDS
+from lawbench.checks.base import TOLERANCE, check
+from lawbench.core.mechanics import gap_rates
+from lawbench.core.problem import RESTITUTION_FIELDS
+from lawbench.core.trial import Trial
 
 # Rounding allowed on a gap rate, relative to the sum of the velocities it is the difference of.
 ROUNDING = 1e3 * float(np.finfo(float).eps)
@@ -38,7 +39,7 @@ def energy_kept(trial: Trial) -> tuple:
     if problem.frictional:
         return None, None, "some contact has friction"
     closed = problem.closed
-    if not all((problem.restitution(kind)[closed] == 1.0).all() for kind in RESTITUTION_KINDS):
+    if not all((problem.restitution(kind)[closed] == 1.0).all() for kind in RESTITUTION_FIELDS):
         return None, None, "some closed contact is not elastic (e < 1)"
     relative = outcome.dT / outcome.T_minus if outcome.T_minus > 0 else outcome.dT
     passed = abs(relative) <= TOLERANCE

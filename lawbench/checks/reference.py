@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from lawbench.checks.base import Trial, check
+from lawbench.checks.base import check
+from lawbench.core.trial import Trial
 
 # References are closed forms; the laws they describe are exact up to solver polishing.
 REFERENCE_TOLERANCE = 1e-8

@@ -6,10 +6,10 @@ Source: G. Darboux (1880), J.B. Keller (1986) and W.J. Stronge (1990), as given 
 restitution ended by one of three rules (option ``termination``), each reading its own
 coefficient of the contact:
 
-- ``newton`` (``restitution('newton')``): ``un = -e un-``;
-- ``poisson`` (``restitution('poisson')``): ``Pn = (1 + e) Pn_c``, ``Pn_c`` the compression
+- ``newton`` (``restitution('kinematic')``): ``un = -e un-``;
+- ``poisson`` (``restitution('kinetic')``): ``Pn = (1 + e) Pn_c``, ``Pn_c`` the compression
   impulse;
-- ``energetic`` (default, Stronge; ``restitution('energy')``): the work of the normal force in
+- ``energetic`` (default, Stronge; ``restitution('energetic')``): the work of the normal force in
   restitution is ``e^2`` times minus its work in compression, ``W_r = -e^2 W_c`` with
   ``W = int un dPn``.
 
@@ -59,6 +59,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from lawbench.laws._claims import keeps_energy, never_creates_energy
 from lawbench.laws.darboux_keller.dynamics import (
     ImpactRecord,
     SingleContactImpact,
@@ -66,16 +67,16 @@ from lawbench.laws.darboux_keller.dynamics import (
     path_arrays,
 )
 
-from lawbench.claims import keeps_energy, never_creates_energy
-from lawbench.law import LAWS, Law
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.regions import option
-from lawbench.spec import Spec
-from lawbench.tags import Tags
+from lawbench.checks.declared import STUDIES, impact_path
+from lawbench.checks.regions import option
+from lawbench.core.law import LAWS, Law
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
 
 # Each termination reads the contact's coefficient of its own kind.
-COEFFICIENT = {"newton": "newton", "poisson": "poisson", "energetic": "energy"}
+COEFFICIENT = {"newton": "kinematic", "poisson": "kinetic", "energetic": "energetic"}
 
 
 class DarbouxKeller(Law):
@@ -186,8 +187,6 @@ def _path(problem: ImpactProblem, record: ImpactRecord) -> dict[str, np.ndarray]
 LAWS.register(DarbouxKeller())
 
 # The study this law declares: its stick and slip phases, in "inside an impact".
-from lawbench.study import STUDIES  # noqa: E402
-from lawbench.study_shapes import impact_path  # noqa: E402
 
 STUDIES.register(
     impact_path("darboux_keller", "lamina", "stick and slip phases along the normal impulse")

@@ -15,7 +15,7 @@ Stick and slip from rest keep their ``r`` for the rest of the impact; planar sli
 ``ut != 0`` is affine too, and so is spatial slip whose rate ``Gtn - mu Gtt ut/|ut|`` lies along
 ``ut`` (a sphere, or slip in a plane of symmetry). Other spatial slip turns its direction
 (Brogliato 2010, eq. 15): it is integrated with the shared event integrator
-(`lawbench.integrator`) until it stops, the impact ends, or the slip speed falls below a
+(`lawbench.numerics.integrator`) until it stops, the impact ends, or the slip speed falls below a
 threshold proportional to ``rtol``, where sticking or slip in a fixed direction (Darboux's
 proposition) takes over exactly. Its clock is ``tau`` with
 ``dPn = |ut| dtau``, which makes the right-hand side smooth; near the stop the slip direction
@@ -36,8 +36,8 @@ from functools import partial
 import numpy as np
 import scipy.optimize
 
-from lawbench.errors import NotApplicable, SolverFailure
-from lawbench.integrator import EventIntegrator
+from lawbench.core.errors import NotApplicable, SolverFailure
+from lawbench.numerics.integrator import EventIntegrator
 
 # Velocity-like quantities below this fraction of |u-| are zero; impulses likewise.
 ROUNDING = 1e-12

@@ -12,7 +12,7 @@ their integration are in `lawbench.laws.jia.dynamics`.
   energies, and the contact sticks while ``E_t < mu^2 eta^2 E_n`` (Coulomb's bound on the
   spring force), slips otherwise. At the end of compression the normal stiffness rises from
   ``k_0`` to ``k_0 / e^2`` with the force unchanged, so the spring keeps ``e^2`` of its energy:
-  ``e`` is the energetic coefficient (``contact.restitution('energy')``). The tangential
+  ``e`` is the energetic coefficient (``contact.restitution('energetic')``). The tangential
   stiffness ``k'`` never changes; ``eta0^2 = k_0 / k'`` is the contact's
   ``tangential_stiffness_ratio``. When it is None the law takes Mindlin's ratio for identical
   elastic bodies with Poisson's ratio 0.3, ``(2 - nu) / (2 (1 - nu)) = 17/14`` (Jia's bouncing
@@ -58,25 +58,26 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.laws.jia.dynamics import SpringImpact, Springs
-
-from lawbench.claims import (
+from lawbench.laws._claims import (
     ENERGETIC_DISSIPATION,
     FROZEN_CONFIGURATION,
     PAOLI_DISCONTINUITY,
     keeps_energy,
     never_creates_energy,
 )
-from lawbench.errors import NotApplicable
-from lawbench.law import LAWS, Law
-from lawbench.mechanics import is_diagonal
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.regions import nonlinear_springs
-from lawbench.solvers import solve_lcp
-from lawbench.spec import Spec
-from lawbench.tags import Tags
-from lawbench.verdicts import Claim
+from lawbench.laws.jia.dynamics import SpringImpact, Springs
+
+from lawbench.checks.declared import STUDIES, impact_path
+from lawbench.checks.regions import nonlinear_springs
+from lawbench.core.errors import NotApplicable
+from lawbench.core.law import LAWS, Law
+from lawbench.core.mechanics import is_diagonal
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.core.verdicts import Claim
+from lawbench.numerics.solvers import solve_lcp
 
 POISSON_RATIO = 0.3
 DEFAULT_TANGENTIAL_STIFFNESS_RATIO = (2 - POISSON_RATIO) / (2 * (1 - POISSON_RATIO))
@@ -160,7 +161,7 @@ class Jia(Law):
         if not (un < -APPROACH * np.abs(np.concatenate([un, problem.ut])).max()).any():
             diagnostics = {"formulation": "no approaching contact", "sequence": [], "steps": 0}
             return Outcome.from_impulses(problem, np.zeros(problem.m), diagnostics=diagnostics)
-        e = problem.restitution("energy")
+        e = problem.restitution("energetic")
         if not d and is_diagonal(problem.delassus) and not options["path"]:
             Pn = np.where(un < 0, -(1 + e) * un / np.diag(problem.delassus), 0.0)
             formulation = "closed form" if problem.m == 1 else "decoupled (diagonal Delassus)"
@@ -262,8 +263,6 @@ def _check_chain(problem: ImpactProblem) -> None:
 LAWS.register(Jia())
 
 # The study this law declares: its impulse curve, in the report's "inside an impact".
-from lawbench.study import STUDIES  # noqa: E402
-from lawbench.study_shapes import impact_path  # noqa: E402
 
 STUDIES.register(
     impact_path("jia", "ball_chain", "Jia's impulse curve for two colliding balls", {"n": 2})

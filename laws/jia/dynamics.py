@@ -50,7 +50,7 @@ are regular (multiplied by ``dI_n/dtau``)::
 
 with ``rho = -mu kappa eta0^2 un`` (the rate of ``|g|`` that keeps ``|F_t| = mu F_n``),
 ``E_t = |g|^2 / (4 eta0^2)`` and the stick bound ``|g| <= 2 mu eta0^2 sqrt(kappa) y``. Every
-transition is an event of the shared event integrator (`lawbench.integrator`, DOP853); the
+transition is an event of the shared event integrator (`lawbench.numerics.integrator`, DOP853); the
 contact velocity is affine in the impulses, ``u = u- + G [I_n, I_t]`` with ``G`` the contact
 Delassus matrix.
 """
@@ -63,9 +63,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lawbench.errors import SolverFailure
-from lawbench.integrator import EventIntegrator
-from lawbench.mechanics import for_products
+from lawbench.core.errors import SolverFailure
+from lawbench.core.mechanics import for_products
+from lawbench.numerics.integrator import EventIntegrator
 
 # Gap rates above -max(ROUNDING, 100 tolerance) |u-| count as not approaching: a grazing
 # contact is not reactivated by the integration's noise.

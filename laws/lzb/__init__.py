@@ -17,7 +17,7 @@ forces (a per-contact exponent is allowed: the rule is then the ratio of the for
 in compression while ``un_j < 0``, in expansion after; its *cycle* ends when its energy is
 released. It may be compressed again during an expansion (several compression/expansion
 phases in one cycle, lectures' remark after eq. 42), and starts a new cycle if it approaches
-after its cycle ended. Stronge's coefficient ``e*_j = contact.restitution("energy")`` ends each
+after its cycle ended. Stronge's coefficient ``e*_j = contact.restitution("energetic")`` ends each
 cycle (eq. 42): the work released in expansion is ``e*^2`` times the work of compression, both
 summed over the cycle.
 
@@ -114,21 +114,22 @@ from typing import Any
 
 import numpy as np
 import scipy.special
-from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
-
-from lawbench.claims import (
+from lawbench.laws._claims import (
     ENERGETIC_DISSIPATION,
     FROZEN_CONFIGURATION,
     PAOLI_DISCONTINUITY,
     keeps_energy,
     never_creates_energy,
 )
-from lawbench.law import LAWS, Law
-from lawbench.mechanics import is_diagonal
-from lawbench.outcome import Outcome
-from lawbench.problem import ImpactProblem
-from lawbench.spec import Spec
-from lawbench.tags import Tags
+from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
+
+from lawbench.checks.declared import STUDIES, impact_path
+from lawbench.core.law import LAWS, Law
+from lawbench.core.mechanics import is_diagonal
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
 
 
 class LiuZhaoBrogliato(Law):
@@ -233,7 +234,7 @@ def _decoupled(problem: ImpactProblem, variant: str, diagnostics: dict[str, Any]
     ``un^2 = 2 G_jj (W_c - E)``), a bi-stiffness expansion ``e*`` times as long, a
     mono-stiffness one the part ``1 - I_(1-e*^2)(a, 1/2)`` of it.
     """
-    G, un, e = np.diag(problem.delassus), problem.un, problem.restitution("energy")
+    G, un, e = np.diag(problem.delassus), problem.un, problem.restitution("energetic")
     approach = np.maximum(-un, 0.0)
     Pn = (1 + e) * approach / G
     work = approach**2 / (2 * G)
@@ -328,8 +329,6 @@ def _path(impact: EnergeticImpact, problem: ImpactProblem) -> dict[str, np.ndarr
 
 
 # The study this law declares: the energy its contacts exchange, in "inside an impact".
-from lawbench.study import STUDIES  # noqa: E402
-from lawbench.study_shapes import impact_path  # noqa: E402
 
 STUDIES.register(
     impact_path("lzb", "bead_column", "energy exchanged between the contacts of the bead column")

@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lawbench.errors import SolverFailure
-from lawbench.integrator import EventIntegrator
-from lawbench.mechanics import for_products
-from lawbench.problem import ImpactProblem
+from lawbench.core.errors import SolverFailure
+from lawbench.core.mechanics import for_products
+from lawbench.core.problem import ImpactProblem
+from lawbench.numerics.integrator import EventIntegrator
 
 IDLE, COMPRESSION, EXPANSION = 0, 1, 2
 # The primary impulse is the independent variable while the primary contact stores at least
@@ -134,7 +134,7 @@ class EnergeticImpact:
         contacts = problem.contacts
         self.K = np.array([c.stiffness for c in contacts])
         self.eta = np.array([c.exponent for c in contacts])
-        self.e = problem.restitution("energy")
+        self.e = problem.restitution("energetic")
         self.mu = problem.mu if self.friction else np.zeros(m)
         G = np.diag(problem.delassus)
         u0 = problem.un

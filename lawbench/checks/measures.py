@@ -1,0 +1,146 @@
+"""Measures a study may ask for: functions of a solved `Trial`, one column each.
+
+*Model error* and *numerical error* are two different measures, never one column:
+
+- `model_error`: the distance of the outcome from the scene's ground truth
+  (``Case.ground_truth``: a closed-form `Reference`, or a converged solution of a stated model),
+  ``max |v+ - v_truth| / max |v-|``;
+- `numerical_error`: the distance from the law's own answer at its tightest accuracy knob
+  (`lawbench.checks.study.tightest`), the same way; 0 for an exact law, None for a knob that chooses
+  between models (an ordering) rather than an accuracy.
+
+Both solve again in the worker; each answer is kept per process, so a sweep pays for the
+ground truth once per worker. A measure returns None where it does not apply.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+
+from lawbench.checks.continuity import jumps
+from lawbench.checks.dispersion import dispersion_index as _index
+from lawbench.checks.study import tightest
+from lawbench.core.errors import LawbenchError
+from lawbench.core.law import LAWS
+from lawbench.core.mechanics import energy_shares as _shares
+from lawbench.core.problem import ImpactProblem, is_sparse
+from lawbench.core.trial import Trial
+
+# Answers solved again, per process: (law, options, problem) -> v_plus or None.
+_SOLVED: dict[str, np.ndarray | None] = {}
+
+
+def _digest(problem: ImpactProblem) -> str:
+    import hashlib  # on first use: it loads OpenSSL, 3 ms of a small command's start-up
+
+    digest = hashlib.sha1(repr(problem.contacts).encode())
+    for part in (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps):
+        if part is None:
+            continue
+        # A sparse matrix by its stored entries and their places (CSC, as the problem keeps it).
+        arrays = (part.data, part.indices, part.indptr) if is_sparse(part) else (part,)
+        for array in arrays:
+            digest.update(np.ascontiguousarray(array).tobytes())
+    return digest.hexdigest()
+
+
+def _solve(law: str, options: dict[str, Any], problem: ImpactProblem) -> np.ndarray | None:
+    """``law``'s post-impact velocity on ``problem``, once per process; None when it fails."""
+    key = json.dumps([law, options, _digest(problem)], sort_keys=True, default=str)
+    if key not in _SOLVED:
+        try:
+            _SOLVED[key] = LAWS.get(law).resolve(problem, **options).v_plus
+        except LawbenchError:
+            _SOLVED[key] = None
+    return _SOLVED[key]
+
+
+def _distance(trial: Trial, v: np.ndarray | None) -> float | None:
+    if v is None:
+        return None
+    scale = max(float(np.abs(trial.problem.v).max()), 1e-300)
+    return float(np.abs(trial.outcome.v_plus - v).max() / scale)
+
+
+def truth(trial: Trial) -> np.ndarray | None:
+    """The scene's ground truth on this trial's problem, or None where it has none.
+
+    A closed form holds at the scene's own parameters only: not on a transformed problem, nor
+    where its condition fails.
+    """
+    case = trial.case
+    ground = case.ground_truth if case is not None else None
+    if ground is None:
+        return None
+    if ground.law is not None:
+        return _solve(ground.law, dict(ground.options), trial.problem)
+    reference = next(r for r in case.references if r.name == ground.reference)
+    built = case.build(**trial.params)
+    if _digest(built) != _digest(trial.problem) or reference.condition(trial.params):
+        return None
+    if any(trial.params.get("gaps", ())):
+        return None
+    return np.asarray(reference.v_plus(trial.params), dtype=float)
+
+
+def model_error(trial: Trial) -> float | None:
+    """``max |v+ - v_truth| / max |v-|`` against the scene's ground truth."""
+    return _distance(trial, truth(trial))
+
+
+def numerical_error(trial: Trial) -> float | None:
+    """``max |v+ - v_own| / max |v-|`` against the law's answer at its tightest knob."""
+    law = trial.law
+    if law.tags.accuracy_knob is None:
+        return 0.0
+    tight = tightest(law)
+    if not tight:
+        return None
+    return _distance(trial, _solve(law.name, {**trial.options, **tight}, trial.problem))
+
+
+def truth_velocity(trial: Trial) -> list[float] | None:
+    """The ground truth's post-impact velocity itself (a list column)."""
+    v = truth(trial)
+    return None if v is None else v.tolist()
+
+
+def energy_shares(trial: Trial) -> dict[str, float]:
+    """Share of the post-impact kinetic energy carried by each body."""
+    return _shares(trial.problem, trial.outcome.v_plus)
+
+
+def dispersion_index(trial: Trial) -> float:
+    """Normalized entropy of the energy shares (0: one body has it all, 1: spread evenly)."""
+    return _index(_shares(trial.problem, trial.outcome.v_plus))
+
+
+def continuity_jumps(trial: Trial) -> dict[str, list[float]] | None:
+    """Outcome jump per perturbation size, under gaps and under velocities.
+
+    At the sizes of the study's ``continuity_sizes`` setting
+    (`lawbench.checks.continuity.jumps`); None on one contact or when a perturbed solve fails.
+    """
+    if trial.problem.m < 2:
+        return None
+    sizes = tuple(trial.settings.get("continuity_sizes", (1e-2, 1e-4, 1e-6)))
+    try:
+        return {**jumps(trial, sizes), "sizes": list(sizes)}
+    except LawbenchError:
+        return None
+
+
+def impact_path(trial: Trial) -> dict[str, Any] | None:
+    """The quantities along the impact (option ``path``) and the phases the law reports."""
+    outcome = trial.outcome
+    if not outcome.path:
+        return None
+    diagnostics = outcome.diagnostics
+    return {
+        "path": {key: np.asarray(value, dtype=float) for key, value in outcome.path.items()},
+        "phases": list(diagnostics.get("phases", [])),
+        "phase_impulses": [float(p) for p in diagnostics.get("phase_impulses", [])],
+    }

@@ -1,0 +1,351 @@
+"""Studies as data: a grid of cells, what it measures and which checks decide its verdicts.
+
+A study (laws x scenes x parameters x options x transforms) is declared where its scene or law is
+(in the module of the case or the law) and registered in `STUDIES`; the engine knows none by name.
+Its grid expands deterministically into `Job` cells (one law with options on one scene with
+parameters, optionally a named transform of the built problem, `lawbench.numerics.transforms`); the
+executor (`lawbench.studies.runner`) runs every cell the same way and returns one tidy table whose
+rows are `lawbench.studies.record.Record` rows: the outcome, the measured columns, and the verdict
+of each named check.
+
+Declaring a study, in a case module::
+
+    def omega_ratio(trial):
+        return trial.outcome.v_plus[2] / trial.problem.v[2]
+
+    STUDIES.register(
+        Study(
+            name="rocking_block",
+            title="omega+/omega- over aspect ratios",
+            cases=("rocking_block",),
+            laws="every",
+            grid={"width": np.logspace(-1, 1, 9).tolist(), "mu": [0.0, 1.0]},
+            params={"height": 1.0, "e": 0.0},
+            measures={"omega_ratio": omega_ratio},
+        )
+    )
+
+A measure reads the `Trial` and returns a number, a sequence of numbers (a list column), a
+mapping of arrays, or None where it does not apply. Measures travel to worker processes by
+reference: declare them as module-level functions (or `functools.partial` of one), not lambdas.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import json
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from lawbench.core.errors import InvalidProblem
+
+if TYPE_CHECKING:
+    from lawbench.core.case import Case
+    from lawbench.core.law import Law
+    from lawbench.core.trial import Trial
+
+Measure = Callable[[Any], Any]
+# Which laws a study compares, when it names none: every law whose tags cover the scene's
+# requirements ('covering'), every law that accepts the problem built at the study's fixed
+# parameters ('able'), or every registered law, refusals included ('every').
+LAW_CHOICES = ("covering", "able", "every")
+# Values of an integer accuracy knob in a sweep.
+INT_KNOBS = (10, 100, 1_000, 10_000, 100_000)
+# The tightest value tried for a numeric accuracy knob (or the nearest its spec accepts).
+TIGHTEST = 1e-12
+
+
+def _cli(value: Any) -> str:
+    """A value as ``--set`` reads it back exactly: lists comma-joined, floats in full."""
+    if isinstance(value, list | tuple):
+        return ",".join(_cli(v) for v in value)
+    if isinstance(value, float):
+        return repr(float(value))
+    return str(value)
+
+
+@dataclass(frozen=True)
+class Job:
+    """One cell: a law with options on a scene with parameters, optionally transformed.
+
+    Attributes
+    ----------
+    law, case : str
+        Registered names.
+    params, options : mapping
+        Scene parameters and law options given (the others take their defaults).
+    transform : str
+        A transform's spelling (``grazing=1e-08``), '' for none.
+    repeat : int
+        Which repetition of the same cell (timing studies solve a cell several times).
+    """
+
+    law: str
+    case: str
+    params: Mapping[str, Any] = field(default_factory=dict)
+    options: Mapping[str, Any] = field(default_factory=dict)
+    transform: str = ""
+    repeat: int = 0
+
+    @property
+    def key(self) -> str:
+        """A stable identity of the cell's content, for resuming."""
+        content: list[Any] = [self.law, self.case, dict(self.params), dict(self.options)]
+        if self.transform or self.repeat:
+            content += [self.transform, self.repeat]
+        text = json.dumps(content, sort_keys=True)
+        import hashlib  # on first use: it loads OpenSSL, 3 ms of a small command's start-up
+
+        return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+    def solve(self, settings: Mapping[str, Any] | None = None) -> Trial:
+        """Build the problem, apply the transform and solve it: the `Trial` the checks read.
+
+        A transformed problem is no longer the scene at its parameters: its trial is that of a
+        problem given as it is (no scene, so no scene references, and the momenta every
+        contact leaves alone are the conserved ones).
+
+        Raises
+        ------
+        InvalidProblem, NotApplicable, SolverFailure
+            As `lawbench.evaluate` does; a bad transform is an `InvalidProblem`.
+        """
+        from lawbench.core.case import CASES
+        from lawbench.core.law import LAWS
+        from lawbench.core.trial import Trial
+        from lawbench.numerics.transforms import apply
+
+        law, case = LAWS.get(self.law), CASES.get(self.case)
+        params = case.parameters(**self.params)
+        problem = apply(self.transform, case.build(**params))
+        outcome = law.resolve(problem, **dict(self.options))
+        options = outcome.diagnostics["options"]
+        if self.transform:
+            case, params = None, {}
+        return Trial(law, case, params, options, problem, outcome, dict(settings or {}))
+
+    def command(self, max_seconds: float | None = None) -> str:
+        """The ``lawbench solve`` command that solves this cell again, exactly."""
+        words = ["lawbench", "solve", self.law, self.case]
+        words += [f"--set {k}={_cli(v)}" for k, v in self.params.items()]
+        words += [f"--option {k}={_cli(v)}" for k, v in self.options.items()]
+        if self.transform:
+            words.append(f"--transform {self.transform}")
+        if max_seconds is not None:
+            words.append(f"--max-seconds {max_seconds:g}")
+        return " ".join(words)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What the executor runs: cells, the checks deciding their verdicts, and what to measure."""
+
+    name: str
+    jobs: list[Job]
+    checks: tuple[str, ...] = ()
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    measures: Mapping[str, Measure] = field(default_factory=dict)
+
+
+def knob_values(law: Law, values: Sequence[float]) -> tuple[str | None, list[Any]]:
+    """A law's accuracy knob and the values a sweep gives it.
+
+    Those of ``values`` its spec accepts, every choice of a choice knob, a few decades of an
+    integer one; ``(None, [None])`` for an exact law.
+    """
+    knob = law.tags.accuracy_knob
+    spec = next((s for s in law.options if s.name == knob), None)
+    if spec is None:
+        return None, [None]
+    if spec.choices:
+        return knob, list(spec.choices)
+    if spec.kind == "bool":
+        return knob, [False, True]
+    candidates = INT_KNOBS if spec.kind == "int" else values
+    return knob, [v for v in candidates if _accepts(spec, v)] or [spec.default]
+
+
+def tightest(law: Law) -> dict[str, Any]:
+    """Options at a law's tightest numeric knob; {} for an exact law or a choice knob."""
+    knob = law.tags.accuracy_knob
+    spec = next((s for s in law.options if s.name == knob), None)
+    if spec is None or spec.choices or spec.kind in ("bool", "str"):
+        return {}
+    if spec.kind == "int":
+        return {knob: max(v for v in (*INT_KNOBS, spec.default) if _accepts(spec, v))}
+    accepted = [TIGHTEST * 10.0**k for k in range(12) if _accepts(spec, TIGHTEST * 10.0**k)]
+    return {knob: accepted[0]} if accepted else {}
+
+
+def _accepts(spec: Any, value: Any) -> bool:
+    try:
+        spec.coerce(value)
+    except InvalidProblem:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class Study:
+    """A named grid of laws x scenes x parameters x options x transforms, with its columns.
+
+    Attributes
+    ----------
+    name : str
+        The name users type (``lawbench study NAME``).
+    title : str
+        What the study shows, with its fixed settings and units.
+    cases : tuple of str or None
+        The scenes it runs on; None for every registered scene.
+    laws : tuple of str or str
+        The laws it compares, or one of `LAW_CHOICES`.
+    grid : mapping
+        Scene parameter -> values; cells are the Cartesian product, in the order written.
+    params : mapping
+        Scene parameters fixed for every cell.
+    options : mapping
+        Law name -> option -> values (a grid of that law's options).
+    knobs : sequence of float
+        When given, each law's accuracy knob is swept over these values (`knob_values`).
+    transform : str or None
+        A transform of `lawbench.numerics.transforms.TRANSFORMS` applied to every cell, with each of
+        ``transform_values``.
+    transform_values : sequence of float
+        The transform's values.
+    measures : mapping
+        Column name -> function of the `Trial` (module-level, see the module docstring).
+    checks : tuple of str or None
+        Checks whose verdicts the table carries (None: every single-solve check); a cell's
+        verdict is the worst of them.
+    settings : mapping
+        Settings of the checks that solve again (``continuity_sizes``).
+    repeats : int
+        Solves per cell (timing studies keep the median).
+    axes : tuple of str
+        The columns a view draws along: a grid parameter, ``transform_value`` or a measure.
+    units : mapping
+        Measure (or quantity a view draws) -> its unit ('' for dimensionless); views label
+        their axes with it (a grid parameter takes the unit of its scene's `Spec`).
+    view : str or None
+        The report section that shows the study (``lawbench.views.report``), None for none.
+    slow : bool
+        Left out of the quick report (a long sweep).
+    full : mapping
+        Field replacements in the full report (larger grids).
+    """
+
+    name: str
+    title: str
+    cases: tuple[str, ...] | None = None
+    laws: tuple[str, ...] | str = "covering"
+    grid: Mapping[str, Sequence[Any]] = field(default_factory=dict)
+    params: Mapping[str, Any] = field(default_factory=dict)
+    options: Mapping[str, Mapping[str, Sequence[Any]]] = field(default_factory=dict)
+    knobs: Sequence[float] = ()
+    transform: str | None = None
+    transform_values: Sequence[float] = ()
+    measures: Mapping[str, Measure] = field(default_factory=dict)
+    checks: tuple[str, ...] | None = None
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    repeats: int = 1
+    axes: tuple[str, ...] = ()
+    units: Mapping[str, str] = field(default_factory=dict)
+    view: str | None = None
+    slow: bool = False
+    full: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if isinstance(self.laws, str) and self.laws not in LAW_CHOICES:
+            raise ValueError(f"study {self.name}: laws {self.laws!r} not in {LAW_CHOICES}")
+
+    def case_names(self) -> list[str]:
+        """The scenes of the study."""
+        from lawbench.core.case import CASES
+
+        return list(self.cases) if self.cases is not None else CASES.names()
+
+    def law_names(self, case: Case) -> list[str]:
+        """The laws of the study on ``case`` (see ``laws``)."""
+        from lawbench.core.law import LAWS
+
+        if not isinstance(self.laws, str):
+            return list(self.laws)
+        if self.laws == "every":
+            return LAWS.names()
+        if self.laws == "able":
+            problem = case.build(**self.params)
+            return [law.name for law in LAWS.values() if law.tags.refusal(problem) is None]
+        return [law.name for law in LAWS.values() if law.tags.covers(case.requires)]
+
+    def preset(self, mode: str) -> Study:
+        """The study as the report's ``mode`` ('quick' or 'full') runs it."""
+        return dataclasses.replace(self, **self.full) if mode == "full" else self
+
+    def with_params(self, given: Mapping[str, Any]) -> Study:
+        """The study with parameters fixed (a grid parameter given is no longer swept)."""
+        grid = {k: v for k, v in self.grid.items() if k not in given}
+        return dataclasses.replace(self, grid=grid, params={**self.params, **given})
+
+    def jobs(
+        self, laws: Sequence[str] | None = None, cases: Sequence[str] | None = None
+    ) -> Iterator[Job]:
+        """Every cell, those of ``laws`` on ``cases`` when given.
+
+        Scenes outermost, then laws, the parameter grid, the option grid, the transform values
+        and the repeats.
+
+        Raises
+        ------
+        InvalidProblem
+            For a parameter or option its scene or law does not accept, naming the study.
+        """
+        from lawbench.core.case import CASES
+        from lawbench.core.law import LAWS
+        from lawbench.numerics.transforms import spell
+
+        transforms = [spell(self.transform, v) for v in self.transform_values] or [""]
+        for case_name in self.case_names():
+            if cases is not None and case_name not in cases:
+                continue
+            case = CASES.get(case_name)
+            for law_name in self.law_names(case):
+                if laws is not None and law_name not in laws:
+                    continue
+                option_grid = {k: list(v) for k, v in self.options.get(law_name, {}).items()}
+                if self.knobs:
+                    knob, values = knob_values(LAWS.get(law_name), self.knobs)
+                    if knob is not None:
+                        option_grid[knob] = values
+                for params in _product(self.grid):
+                    params = {**self.params, **params}
+                    for options in _product(option_grid):
+                        self._check(case, LAWS.get(law_name), params, options)
+                        for transform in transforms:
+                            for repeat in range(self.repeats):
+                                yield Job(law_name, case_name, params, options, transform, repeat)
+
+    def check_names(self) -> tuple[str, ...]:
+        """The checks deciding the verdicts (``checks``, or every single-solve check)."""
+        from lawbench.checks import SINGLE_SOLVE
+
+        return tuple(SINGLE_SOLVE if self.checks is None else self.checks)
+
+    def plan(self, laws: Sequence[str] | None = None, cases: Sequence[str] | None = None) -> Plan:
+        """The executor's plan of this study (restricted to ``laws`` and ``cases``)."""
+        jobs = list(self.jobs(laws, cases))
+        return Plan(self.name, jobs, self.check_names(), dict(self.settings), dict(self.measures))
+
+    def _check(self, case: Case, law: Law, params: dict, options: dict) -> None:
+        try:
+            case.parameters(**params)
+            law.option_values(options)
+        except InvalidProblem as exc:
+            raise InvalidProblem(f"study {self.name}, {law.name} on {case.name}: {exc}") from None
+
+
+def _product(choices: Mapping[str, Sequence[Any]]) -> Iterator[dict[str, Any]]:
+    names = list(choices)
+    for combination in itertools.product(*(choices[name] for name in names)):
+        yield dict(zip(names, combination, strict=True))

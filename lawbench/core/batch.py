@@ -1,0 +1,297 @@
+"""Many impact problems of one shape, stacked, and their outcomes.
+
+A `ProblemBatch` holds B problems with the same numbers of coordinates and contacts as stacked
+arrays, validated once for the whole batch with the same rules as `ImpactProblem`. A law solves it
+with `Law.resolve_batch`: a law with a vectorized path (closed forms and active-set enumeration on
+the Delassus matrices, `lawbench.numerics.solvers.enumerate_lcp`) solves every problem in a few
+numpy calls; the others are solved one by one. Either way the answer equals the one-by-one path to
+rounding.
+
+Sign conventions as everywhere: ``un = Wn.T @ v``, ``Pn >= 0`` pushes apart,
+``v_plus = v + M^-1 Wn Pn``. Batches are frictionless and simultaneous (no tangential
+Jacobian, zero gaps): the problems where many small impacts are solved at once.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.problem import RESTITUTION_FIELDS, Contact, ImpactProblem, all_finite
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+_OVERFLOW = "M is too close to singular (its inverse overflows)"
+# Contact fields a batch carries per problem and contact, with their allowed ranges.
+COEFFICIENTS = {"e": (0.0, 1.0), "e_newton": (0.0, 1.0), "e_poisson": (0.0, 1.0)}
+
+
+def _stack(name: str, value: object, shape: tuple[int, ...], batch: int | None) -> np.ndarray:
+    """``value`` as a float array (B, *shape); one array of ``shape`` serves every problem."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
+    # Before broadcasting: one array that serves every problem is checked once.
+    finite = all_finite(array)
+    if array.shape == shape and batch is not None:
+        array = np.broadcast_to(array, (batch, *shape))
+    if array.ndim != len(shape) + 1 or array.shape[1:] != shape:
+        raise InvalidProblem(f"{name} has shape {array.shape}, expected (B, {shape}) or {shape}")
+    if not finite:
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
+        raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class ProblemBatch:
+    """B frictionless simultaneous impact problems of one shape, validated once.
+
+    Parameters
+    ----------
+    M : array (B, n, n) or (n, n)
+        Mass matrices (one serves every problem).
+    Wn : array (B, n, m) or (n, m)
+        Normal Jacobians.
+    v : array (B, n)
+        Pre-impact velocities; B is the number of rows.
+    coefficients : mapping of str to array (B, m)
+        Restitution coefficients per problem and contact (``e``, ``e_newton``,
+        ``e_poisson``), in [0, 1].
+
+    Raises
+    ------
+    InvalidProblem
+        Naming the field, the problem and the value, like `ImpactProblem`.
+    """
+
+    M: np.ndarray
+    Wn: np.ndarray
+    v: np.ndarray
+    coefficients: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        v = np.asarray(self.v, dtype=float)
+        if v.ndim != 2 or v.shape[0] < 1 or v.shape[1] < 1:
+            raise InvalidProblem(f"v has shape {v.shape}, expected (B, n) with B, n >= 1")
+        batch, n = v.shape
+        m = np.shape(self.Wn)[-1] if np.ndim(self.Wn) >= 2 else 0
+        if m < 1:
+            raise InvalidProblem(f"Wn has shape {np.shape(self.Wn)}, expected (B, n, m)")
+        set_ = object.__setattr__
+        set_(self, "v", _stack("v", v, (n,), None))
+        set_(self, "M", _stack("M", self.M, (n, n), batch))
+        set_(self, "Wn", _stack("Wn", self.Wn, (n, m), batch))
+        for name in (f for f in ("M", "Wn") if getattr(self, f).shape[0] != batch):
+            raise InvalidProblem(f"{name} holds {getattr(self, name).shape[0]} problems, v {batch}")
+        coefficients = {}
+        for name, value in self.coefficients.items():
+            if name not in COEFFICIENTS:
+                raise InvalidProblem(
+                    f"unknown batch coefficient {name!r}; known: {', '.join(COEFFICIENTS)}"
+                )
+            array = np.broadcast_to(np.asarray(value, dtype=float), (batch, m))
+            low, high = COEFFICIENTS[name]
+            # NaN fails both comparisons.
+            if not (array.min() >= low and array.max() <= high):
+                k, j = (int(i) for i in np.argwhere(~((array >= low) & (array <= high)))[0])
+                raise InvalidProblem(
+                    f"problem {k}: contacts[{j}].{name} = {array[k, j]}: must be in "
+                    f"[{low:g}, {high:g}]"
+                )
+            coefficients[name] = array
+        coefficients.setdefault("e", np.ones((batch, m)))
+        set_(self, "coefficients", coefficients)
+        smallest = self._factor_mass()
+        # The criterion of `ImpactProblem`: a normal Delassus entry at rounding level against
+        # the largest inverse mass times the largest squared column of Wn.
+        diagonal = np.einsum("kjj->kj", self.delassus)
+        inverse_mass = 1.0 / smallest
+        floor = 1e-12 * inverse_mass * np.einsum("kij,kij->kj", self.Wn, self.Wn).max(axis=1)
+        for k, j in np.argwhere(diagonal <= floor[:, None])[:1]:
+            raise InvalidProblem(
+                f"problem {k}: contacts[{j}]: no motion moves it along its normal "
+                f"(Wn[:, {j}] M^-1 Wn[:, {j}] = {diagonal[k, j]:.3g})"
+            )
+
+    def _factor_mass(self) -> np.ndarray:
+        """Check every M and keep its inverse; return the smallest eigenvalue of each.
+
+        Diagonal mass matrices (particles, chains) are inverted entry by entry, exactly.
+        """
+        masses = np.einsum("kii->ki", self.M)
+        if np.count_nonzero(self.M) == np.count_nonzero(masses):
+            smallest = masses.min(axis=1)
+            self._refuse("M is not positive definite", ~(smallest > 0))
+            with np.errstate(all="ignore"):
+                reciprocal = 1.0 / masses
+            object.__setattr__(self, "_inverse_diagonal", reciprocal)
+            if not all_finite(reciprocal):
+                self._refuse(_OVERFLOW, ~np.isfinite(reciprocal).all(axis=1))
+            return smallest
+        asymmetry = np.abs(self.M - np.swapaxes(self.M, 1, 2)).max(axis=(1, 2))
+        asymmetric = asymmetry > 1e-12 * np.abs(self.M).max(axis=(1, 2))
+        for k in np.flatnonzero(asymmetric)[:1]:
+            raise InvalidProblem(f"problem {k}: M is not symmetric ({asymmetry[k]:.3g})")
+        smallest = np.linalg.eigvalsh(self.M)[:, 0]
+        self._refuse("M is not positive definite", ~(smallest > 0))
+        with np.errstate(all="ignore"):
+            inverse = np.linalg.inv(self.M)
+        object.__setattr__(self, "_inverse", inverse)
+        self._refuse(_OVERFLOW, ~np.isfinite(inverse).all(axis=(1, 2)))
+        return smallest
+
+    @staticmethod
+    def _refuse(reason: str, bad: np.ndarray) -> None:
+        """Raise `InvalidProblem` for the first problem where ``bad`` holds."""
+        for k in np.flatnonzero(bad)[:1]:
+            raise InvalidProblem(f"problem {k}: {reason}")
+
+    @classmethod
+    def from_problems(cls, problems: Sequence[ImpactProblem]) -> ProblemBatch:
+        """Stack problems of one shape (frictionless, zero gaps)."""
+        if not problems:
+            raise InvalidProblem("an empty batch: give at least one problem")
+        first = problems[0]
+        for k, problem in enumerate(problems):
+            if (problem.n, problem.m) != (first.n, first.m):
+                raise InvalidProblem(
+                    f"problem {k} has (n, m) = ({problem.n}, {problem.m}), problem 0 has "
+                    f"({first.n}, {first.m}): a batch holds problems of one shape"
+                )
+            if problem.Wt is not None or problem.gaps.any():
+                raise InvalidProblem(
+                    f"problem {k} has a tangential Jacobian or gaps: a batch is frictionless "
+                    "and simultaneous"
+                )
+        coefficients = {
+            name: np.array([[getattr(c, name) for c in p.contacts] for p in problems])
+            for name in COEFFICIENTS
+            if all(getattr(c, name) is not None for p in problems for c in p.contacts)
+        }
+        return cls(
+            np.stack([p.M for p in problems]),
+            np.stack([p.Wn for p in problems]),
+            np.stack([p.v for p in problems]),
+            coefficients,
+        )
+
+    def __len__(self) -> int:
+        return self.v.shape[0]
+
+    @property
+    def n(self) -> int:
+        """Number of generalized coordinates."""
+        return self.v.shape[1]
+
+    @property
+    def m(self) -> int:
+        """Number of contacts."""
+        return self.Wn.shape[2]
+
+    def solve_mass(self, rhs: np.ndarray) -> np.ndarray:
+        """``M^-1 @ rhs`` for every problem (``rhs`` of shape (B, n) or (B, n, k))."""
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None:
+            return reciprocal * rhs if rhs.ndim == 2 else reciprocal[:, :, None] * rhs
+        if rhs.ndim == 2:
+            return np.einsum("kij,kj->ki", self._inverse, rhs)
+        return self._inverse @ rhs
+
+    @cached_property
+    def delassus(self) -> np.ndarray:
+        """Normal Delassus matrices ``Wn.T M^-1 Wn``, (B, m, m)."""
+        reciprocal = self.__dict__.get("_inverse_diagonal")
+        if reciprocal is not None:
+            # One pass over the entries instead of a stack of small matrix products.
+            G = np.einsum("kij,ki,kil->kjl", self.Wn, reciprocal, self.Wn)
+        else:
+            G = np.swapaxes(self.Wn, 1, 2) @ self.solve_mass(self.Wn)
+        return (G + np.swapaxes(G, 1, 2)) / 2
+
+    @cached_property
+    def un(self) -> np.ndarray:
+        """Pre-impact gap rates ``Wn.T @ v``, (B, m)."""
+        return np.einsum("knm,kn->km", self.Wn, self.v)
+
+    def restitution(self, kind: str) -> np.ndarray:
+        """Per-problem, per-contact coefficients of ``kind`` (the override where given), (B, m)."""
+        return self.coefficients.get(RESTITUTION_FIELDS[kind], self.coefficients["e"])
+
+    def kinetic_energy(self, v: np.ndarray) -> np.ndarray:
+        """``v @ M @ v / 2`` for every problem."""
+        if "_inverse_diagonal" in self.__dict__:
+            return 0.5 * np.einsum("kn,kn,kn->k", v, np.einsum("kii->ki", self.M), v)
+        return 0.5 * np.einsum("kn,knl,kl->k", v, self.M, v)
+
+    def problem(self, k: int) -> ImpactProblem:
+        """Problem ``k`` as an `ImpactProblem` (for the one-by-one path)."""
+        fields = {f.name for f in dataclasses.fields(Contact)}
+        contacts = [
+            Contact(
+                **{
+                    name: float(self.coefficients[name][k, j])
+                    for name in self.coefficients
+                    if name in fields
+                }
+            )
+            for j in range(self.m)
+        ]
+        return ImpactProblem(self.M[k], self.Wn[k], self.v[k], contacts)
+
+
+@dataclass(frozen=True, eq=False)
+class OutcomeBatch:
+    """Outcomes of a batch, stacked: the fields of `lawbench.Outcome` with a batch axis.
+
+    Attributes
+    ----------
+    v_plus : array (B, n)
+    Pn : array (B, m)
+    T_minus, T_plus : array (B,)
+    diagnostics : dict
+        ``formulation`` (the vectorized method, or 'one by one'), ``options``, ``wall_time_s``.
+    """
+
+    v_plus: np.ndarray
+    Pn: np.ndarray
+    T_minus: np.ndarray
+    T_plus: np.ndarray
+    diagnostics: dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def from_impulses(cls, batch: ProblemBatch, Pn: np.ndarray, **diagnostics: Any) -> OutcomeBatch:
+        """Apply impulses ``Pn`` (B, m) to every problem of ``batch``."""
+        v_plus = batch.v + batch.solve_mass(np.einsum("knm,km->kn", batch.Wn, Pn))
+        return cls(
+            v_plus,
+            Pn,
+            batch.kinetic_energy(batch.v),
+            batch.kinetic_energy(v_plus),
+            dict(diagnostics),
+        )
+
+    @property
+    def dT(self) -> np.ndarray:
+        """Kinetic energy changes ``T_plus - T_minus`` (positive: energy created)."""
+        return self.T_plus - self.T_minus
+
+    def __len__(self) -> int:
+        return self.v_plus.shape[0]
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per problem: ``v_plus_i``, ``Pn_j``, ``T_minus``, ``T_plus``, ``dT``."""
+        import pandas as pd
+
+        columns = {f"v_plus_{i}": self.v_plus[:, i] for i in range(self.v_plus.shape[1])}
+        columns |= {f"Pn_{j}": self.Pn[:, j] for j in range(self.Pn.shape[1])}
+        columns |= {"T_minus": self.T_minus, "T_plus": self.T_plus, "dT": self.dT}
+        return pd.DataFrame(columns)

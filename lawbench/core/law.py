@@ -1,0 +1,241 @@
+"""The law protocol: what every impact law declares and how it is called.
+
+A law subclasses `Law`, declares its name, summary, source, tags, options, findings and
+guarantees, and implements `Law._resolve`. `Law.resolve` does what is common to all of them: it
+checks the options and the problem against the tags, restricts the problem to its closed contacts
+(a contact with a positive gap is not part of this impact), times the solve within the budget
+its options set (`lawbench.core.budget`: every law has ``max_seconds``), and refuses to return a
+non-finite answer.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import time
+from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from lawbench.core import budget
+from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem, all_finite
+from lawbench.core.registry import Registry
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
+from lawbench.core.verdicts import Claim
+
+if TYPE_CHECKING:
+    from lawbench.core.batch import OutcomeBatch, ProblemBatch
+
+
+class Law(ABC):
+    """Base class of the impact laws.
+
+    Subclasses set the class attributes and implement `_resolve`, which receives a problem
+    whose contacts are all closed and the complete, checked options. ``tags`` say what the law
+    treats (`lawbench.core.tags.Tags`); ``findings`` and ``guarantees`` are `Claim` objects that
+    decide the verdict of a failed check (`lawbench.core.verdicts`).
+    """
+
+    name: ClassVar[str]
+    summary: ClassVar[str]
+    source: ClassVar[str]
+    tags: ClassVar[Tags]
+    options: ClassVar[tuple[Spec, ...]] = ()
+    # Whether the law follows contacts through their gaps (resolves time): then it receives the
+    # whole problem; otherwise only the closed contacts, an open one being no part of the impact.
+    follows_gaps: ClassVar[bool] = False
+    # What the law's theory says of the checks: where one fails as the theory predicts
+    # (findings), and where one must hold, so that a failure there is numerical (guarantees).
+    findings: ClassVar[tuple[Claim, ...]] = ()
+    guarantees: ClassVar[tuple[Claim, ...]] = ()
+    # How the law treats a closed contact that separates before the impact, stated in the
+    # diagnostics of every problem that has one; a law that states no rule refuses them.
+    separating_rule: ClassVar[str] = ""
+    # Whether `_resolve` takes a sparse problem (scipy.sparse M, Wn and Delassus matrix); a law
+    # that does not receives it with numpy arrays.
+    takes_sparse: ClassVar[bool] = False
+    # The roles the law plays in ``lawbench bench`` (`lawbench.studies.bench.ROLES`).
+    bench_roles: ClassVar[tuple[str, ...]] = ()
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Give every law the wall-clock budget ``max_seconds`` (`lawbench.core.budget`)."""
+        super().__init_subclass__(**kwargs)
+        if not any(spec.name == budget.OPTION.name for spec in cls.options):
+            cls.options = (*cls.options, budget.OPTION)
+
+    def rule_for_separating(self, options: dict[str, Any]) -> str:
+        """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
+        return self.separating_rule
+
+    def option_values(self, given: dict[str, Any] | None = None) -> dict[str, Any]:
+        """Return every option of this law, defaults filled in, checked and converted.
+
+        Raises
+        ------
+        InvalidProblem
+            For an unknown option name or a bad value.
+        """
+        if not given:
+            return dict(self._defaults)
+        given = dict(given)
+        specs = {spec.name: spec for spec in self.options}
+        unknown = sorted(set(given) - set(specs))
+        if unknown:
+            known = ", ".join(specs) or "none"
+            raise InvalidProblem(
+                f"unknown option {unknown[0]!r} for law {self.name!r}; known: {known}"
+            )
+        return {name: spec.coerce(given.get(name, spec.default)) for name, spec in specs.items()}
+
+    @functools.cached_property
+    def _defaults(self) -> dict[str, Any]:
+        return {spec.name: spec.coerce(spec.default) for spec in self.options}
+
+    def resolve(self, problem: ImpactProblem, **options: Any) -> Outcome:
+        """Resolve the impact ``problem`` with this law.
+
+        Parameters
+        ----------
+        problem : ImpactProblem
+            The impact; it is not modified.
+        **options
+            The law's options (see ``options``).
+
+        Returns
+        -------
+        Outcome
+            With ``diagnostics['wall_time_s']`` and ``diagnostics['options']`` filled in.
+
+        Raises
+        ------
+        InvalidProblem
+            For a bad option.
+        NotApplicable
+            When the law cannot treat the problem.
+        SolverFailure
+            When the numerical method fails or would return a non-finite number.
+        """
+        values = self.option_values(options)
+        reason = self.tags.refusal(problem)
+        if reason:
+            raise NotApplicable(f"{self.name}: {reason}")
+        separating = problem.separating
+        rule = self.rule_for_separating(values) if separating else ""
+        if separating and not rule:
+            raise NotApplicable(
+                f"{self.name}: closed contacts {list(separating)} separate before the impact, "
+                "and the law states no rule for them"
+            )
+        if problem.sparse and not self.takes_sparse:
+            problem = problem.dense()
+        start = time.perf_counter()
+        with budget.Budget.of(self.name, values):
+            if problem.closed_count == problem.m or self.follows_gaps:
+                outcome = self._resolve(problem, values)
+            elif problem.closed_count:
+                closed = problem.closed
+                outcome = _embed(
+                    self._resolve(problem.select_contacts(closed), values), closed, problem
+                )
+            else:
+                outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
+                outcome.diagnostics["formulation"] = "no closed contact"
+        wall_time = time.perf_counter() - start
+        if problem.Wt is not None and outcome.Pt.size == 0:
+            outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
+        _refuse_non_finite(self.name, outcome)
+        outcome.diagnostics["options"] = values
+        if separating:
+            outcome.diagnostics["separating_contacts"] = list(separating)
+            outcome.diagnostics["separating_rule"] = rule
+        outcome.diagnostics["wall_time_s"] = wall_time
+        return outcome
+
+    @abstractmethod
+    def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        """Resolve a problem whose contacts are all closed."""
+
+    def resolve_batch(self, batch: ProblemBatch, **options: Any) -> OutcomeBatch:
+        """Resolve every problem of ``batch``: vectorized where the law can, else one by one.
+
+        Parameters
+        ----------
+        batch : ProblemBatch
+            Problems of one shape, validated once.
+        **options
+            The law's options, checked once for the whole batch.
+
+        Returns
+        -------
+        OutcomeBatch
+            Equal to resolving each problem with `resolve`, to rounding.
+
+        Raises
+        ------
+        InvalidProblem, NotApplicable, SolverFailure
+            As `resolve`; one by one, the first problem that raises stops the batch.
+        """
+        from lawbench.core.batch import OutcomeBatch  # on first use: a single solve needs no batch
+
+        values = self.option_values(options)
+        start = time.perf_counter()
+        Pn = self._resolve_batch(batch, values)
+        if Pn is not None:
+            formulation = Pn[1]
+            result = OutcomeBatch.from_impulses(batch, Pn[0], formulation=formulation)
+        else:
+            outcomes = [self.resolve(batch.problem(k), **values) for k in range(len(batch))]
+            result = OutcomeBatch(
+                np.stack([o.v_plus for o in outcomes]),
+                np.stack([o.Pn for o in outcomes]),
+                np.array([o.T_minus for o in outcomes]),
+                np.array([o.T_plus for o in outcomes]),
+                {"formulation": "one by one"},
+            )
+        if not np.isfinite(result.v_plus).all():
+            raise SolverFailure(f"{self.name}: non-finite v_plus in a batch")
+        result.diagnostics.update(options=values, wall_time_s=time.perf_counter() - start)
+        return result
+
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """The impulses (B, m) of every problem and the formulation, or None to go one by one.
+
+        A law with a vectorized path overrides this; it must give the answer of `_resolve`.
+        """
+        return None
+
+
+def _refuse_non_finite(name: str, outcome: Outcome) -> None:
+    """Raise `SolverFailure` naming the first field of ``outcome`` with a non-finite number."""
+    if (
+        math.isfinite(outcome.T_plus)
+        and all_finite(outcome.v_plus)
+        and all_finite(outcome.Pn)
+        and all_finite(outcome.Pt)
+    ):
+        return
+    for field in ("v_plus", "Pn", "Pt", "T_plus"):
+        if not all_finite(np.asarray(getattr(outcome, field))):
+            raise SolverFailure(f"{name}: non-finite {field} {getattr(outcome, field)}")
+
+
+def _embed(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outcome:
+    """Give an outcome solved on the closed contacts the impulses of every contact."""
+    Pn = np.zeros(problem.m)
+    Pn[closed] = outcome.Pn
+    Pt = outcome.Pt
+    if Pt.size and problem.d:
+        Pt = np.zeros((problem.m, problem.d))
+        Pt[closed] = outcome.Pt.reshape(-1, problem.d)
+        Pt = Pt.ravel()
+    return dataclasses.replace(outcome, Pn=Pn, Pt=Pt)
+
+
+LAWS: Registry[Law] = Registry("law", "lawbench.laws")

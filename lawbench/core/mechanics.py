@@ -1,0 +1,96 @@
+"""Shared mechanics at a frozen configuration: energy, impulses to velocities, gap rates."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from lawbench.core.problem import (
+    SPARSE_SHARE,
+    ImpactProblem,
+    as_array,
+    has_off_diagonal,
+    kinetic_energy,
+)
+
+if TYPE_CHECKING:
+    import scipy.sparse
+
+# Rows beyond which a CSR product (about 3 us, mostly its dispatch) beats a dense one on a
+# banded matrix.
+SPARSE_PRODUCTS = 200
+
+
+def generalized_impulse(
+    problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
+) -> np.ndarray:
+    """Return the generalized impulse ``Wn @ Pn + Wt @ Pt`` (Pt None or empty: no friction)."""
+    impulse = problem.Wn.dot(Pn)
+    if Pt is not None and np.size(Pt):
+        impulse = impulse + problem.Wt.dot(Pt)
+    return impulse
+
+
+def velocity_after(
+    problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
+) -> np.ndarray:
+    """Return ``v + M^-1 (Wn @ Pn + Wt @ Pt)``, the velocity after the impulses."""
+    return problem.v + problem.solve_mass(generalized_impulse(problem, Pn, Pt))
+
+
+def gap_rates(problem: ImpactProblem, v: np.ndarray) -> np.ndarray:
+    """Return the normal gap rates ``Wn.T @ v`` of every contact at velocity ``v``."""
+    return problem.Wn.T @ v
+
+
+def separating_contacts(problem: ImpactProblem) -> list[int]:
+    """Closed contacts whose gap rate is positive before the impact (they separate)."""
+    return list(problem.separating)
+
+
+def is_diagonal(G: np.ndarray) -> bool:
+    """Whether the Delassus matrix (dense or sparse) decouples the contacts."""
+    return not has_off_diagonal(G)
+
+
+def kinetic_angles(problem: ImpactProblem) -> np.ndarray:
+    """Angles (degrees) between the contact constraints in the kinetic metric, (m, m).
+
+    ``cos(theta_ij) = G_ij / sqrt(G_ii G_jj)`` with ``G`` the Delassus matrix (Brogliato 2010,
+    eq. 26: two balls on a wall, ``cos(theta_12) = -sqrt(m1 / (m1 + m2))``). Paoli's condition:
+    rigid laws with e > 0 are continuous in the initial data only where the angles are right
+    angles (orthogonal constraints).
+    """
+    G = as_array(problem.delassus)
+    scale = np.sqrt(np.diag(G))
+    cosine = np.clip(G / np.outer(scale, scale), -1.0, 1.0)
+    return np.degrees(np.arccos(cosine))
+
+
+def energy_shares(problem: ImpactProblem, v: np.ndarray) -> dict[str, float]:
+    """Share of the kinetic energy at ``v`` carried by each body (``problem.bodies``)."""
+    total = kinetic_energy(problem.M, v)
+    shares = {}
+    for name, indices in problem.bodies.items():
+        idx = list(indices)
+        own = kinetic_energy(problem.M[np.ix_(idx, idx)], v[idx])
+        shares[name] = own / total if total > 0 else 0.0
+    return shares
+
+
+def for_products(A: np.ndarray) -> np.ndarray | scipy.sparse.csr_matrix:
+    """``A`` in the form its matrix-vector products are cheapest in.
+
+    A matrix of more than ``SPARSE_PRODUCTS`` rows that is mostly zeros (a chain's Jacobian
+    or Delassus matrix: banded) as a CSR matrix, whose products cost O(nnz) instead of
+    O(rows x columns); any other as given.
+    The integrating laws evaluate such products at every stage of every step.
+    """
+    import scipy.sparse  # on first use: a closed-form law imports no sparse algebra
+
+    if scipy.sparse.issparse(A):
+        return scipy.sparse.csr_matrix(A)
+    if A.shape[0] > SPARSE_PRODUCTS and np.count_nonzero(A) <= SPARSE_SHARE * A.size:
+        return scipy.sparse.csr_matrix(A)
+    return A

@@ -1,0 +1,138 @@
+"""The result every law returns, with the same fields for all of them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from lawbench.core.mechanics import velocity_after
+from lawbench.core.problem import ImpactProblem
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+
+# The tangential impulse of a frictionless outcome: empty, shared, read-only.
+_NO_IMPULSE = np.zeros(0)
+_NO_IMPULSE.setflags(write=False)
+
+
+@dataclass(frozen=True, eq=False, init=False)
+class Outcome:
+    """Post-impact state of an impact problem.
+
+    Attributes
+    ----------
+    v_plus : array (n,)
+        Post-impact generalized velocity.
+    Pn : array (m,)
+        Normal impulse of every contact (>= 0 pushes apart).
+    Pt : array (m*d,)
+        Tangential impulses; empty without friction.
+    T_minus, T_plus : float
+        Kinetic energy before and after.
+    status : str
+        'ok', or a word a law uses to flag a questionable answer (for example 'ambiguous').
+    diagnostics : dict
+        Formulation used, iterations or steps, solver status, wall time (``wall_time_s``).
+    path : dict or None
+        On request, quantities along the impact variable, for plots.
+    v_minus : array (n,) or None
+        Pre-impact generalized velocity, the problem's ``v`` (None when not given).
+    """
+
+    v_plus: np.ndarray
+    Pn: np.ndarray
+    Pt: np.ndarray
+    T_minus: float
+    T_plus: float
+    status: str = "ok"
+    diagnostics: dict[str, Any] = field(default_factory=dict)
+    path: dict[str, np.ndarray] | None = None
+    v_minus: np.ndarray | None = None
+
+    def __init__(
+        self,
+        v_plus: np.ndarray,
+        Pn: np.ndarray,
+        Pt: np.ndarray,
+        T_minus: float,
+        T_plus: float,
+        status: str = "ok",
+        diagnostics: dict[str, Any] | None = None,
+        path: dict[str, np.ndarray] | None = None,
+        v_minus: np.ndarray | None = None,
+    ) -> None:
+        # Written straight into the instance: the __init__ a frozen dataclass generates sets
+        # each field through object.__setattr__, 1.3 us for these nine against 0.7 us here.
+        state = self.__dict__
+        state["v_plus"], state["Pn"], state["Pt"] = v_plus, Pn, Pt
+        state["T_minus"], state["T_plus"], state["status"] = T_minus, T_plus, status
+        state["diagnostics"] = {} if diagnostics is None else diagnostics
+        state["path"], state["v_minus"] = path, v_minus
+
+    def to_frame(self) -> pd.DataFrame:
+        """The outcome as a tidy frame: one row per quantity and index (v_plus, Pn, Pt, energy).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``quantity``, ``index`` (coordinate or contact; -1 for a scalar), ``value``.
+        """
+        import pandas as pd
+
+        rows = [
+            (name, i, float(x))
+            for name in ("v_plus", "Pn", "Pt")
+            for i, x in enumerate(getattr(self, name))
+        ]
+        rows += [(name, -1, float(getattr(self, name))) for name in ("T_minus", "T_plus", "dT")]
+        return pd.DataFrame(rows, columns=["quantity", "index", "value"])
+
+    def _repr_html_(self) -> str:
+        formulation = self.diagnostics.get("formulation", "")
+        head = f"<p>Outcome ({self.status}; {formulation})</p>"
+        return head + self.to_frame().to_html(index=False)
+
+    @property
+    def dT(self) -> float:
+        """Kinetic energy change ``T_plus - T_minus`` (positive: energy created)."""
+        return self.T_plus - self.T_minus
+
+    @classmethod
+    def from_impulses(
+        cls, problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None, **fields: Any
+    ) -> Outcome:
+        """Build the outcome of applying impulses ``Pn`` (and ``Pt``) to ``problem``.
+
+        ``fields`` are the optional fields (status, diagnostics, path).
+        """
+        return cls.from_velocity(problem, velocity_after(problem, Pn, Pt), Pn, Pt, **fields)
+
+    @classmethod
+    def from_velocity(
+        cls,
+        problem: ImpactProblem,
+        v_plus: np.ndarray,
+        Pn: np.ndarray,
+        Pt: np.ndarray | None = None,
+        *,
+        status: str = "ok",
+        diagnostics: dict[str, Any] | None = None,
+        path: dict[str, np.ndarray] | None = None,
+    ) -> Outcome:
+        """Build an outcome from a post-impact velocity a law computed itself."""
+        v_plus = np.asarray(v_plus, dtype=float)
+        return cls(
+            v_plus,
+            np.asarray(Pn, dtype=float),
+            _NO_IMPULSE if Pt is None else np.asarray(Pt, dtype=float),
+            problem.T_minus,
+            problem.kinetic_energy(v_plus),
+            status,
+            dict(diagnostics or {}),
+            path,
+            problem.v,
+        )

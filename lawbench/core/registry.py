@@ -1,0 +1,166 @@
+"""Registries of laws and cases, filled by the modules of a package and by plugins on first use.
+
+Each module of ``lawbench.laws`` (``lawbench.cases``) registers its entry when imported. Other
+distributions add entries through entry points of the group of the same name
+(``[project.entry-points."lawbench.laws"]``): an entry point names a module (importing it
+registers its entries, like the built-in ones) or a `Law`/`Case` subclass or instance (the
+registry registers it). Asked for one name, a registry imports the module of that name (a
+built-in module or a plugin's entry point) and only that, when it registers the name; asked
+for every name, it imports everything. So importing lawbench, and solving with one law on one
+scene, stay cheap. A module or plugin that fails to import, raises, or
+registers a name twice is skipped and its reason kept in `Registry.unavailable` instead of
+breaking the others.
+
+A registry is a read-only mapping of names to entries: ``LAWS["newton"]``, ``"newton" in
+LAWS``, iteration over the names, ``keys()``, ``values()``, ``items()``, ``len()``. An unknown
+name raises `UnknownName`, both the mapping's `KeyError` and lawbench's `InvalidProblem`, with
+the known names in the message.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import inspect
+import pkgutil
+from collections.abc import Iterator, Mapping
+from typing import Protocol, TypeVar
+
+from lawbench.core.errors import UnknownName
+
+
+def _entry_points(**selection: str) -> list:
+    """The installed entry points selected (``group``, ``name``).
+
+    importlib.metadata is imported here, on first use: it costs a third of the start-up of a
+    command that solves one built-in law on one built-in scene.
+    """
+    import importlib.metadata
+
+    return list(importlib.metadata.entry_points(**selection))
+
+
+class _Named(Protocol):
+    name: str
+
+
+Entry = TypeVar("Entry", bound=_Named)
+
+
+class Registry(Mapping[str, Entry]):
+    """Read-only name -> entry mapping for the entries of one kind ('law', 'case' or 'study').
+
+    Parameters
+    ----------
+    kind : str
+        What the entries are, for messages.
+    package : str
+        Dotted name of the package whose modules register entries.
+    """
+
+    def __init__(self, kind: str, package: str) -> None:
+        self.kind = kind
+        self.package = package
+        self._entries: dict[str, Entry] = {}
+        self.unavailable: dict[str, str] = {}
+        self._loaded = False
+
+    def register(self, entry: Entry) -> Entry:
+        """Add ``entry`` under its name; a name registered twice is an error."""
+        if entry.name in self._entries:
+            raise ValueError(f"{self.kind} {entry.name!r} is already registered")
+        self._entries[entry.name] = entry
+        return entry
+
+    def _load(self) -> None:
+        if self._loaded:
+            return
+        self._loaded = True
+        package = importlib.import_module(self.package)
+        for module in sorted(pkgutil.iter_modules(package.__path__), key=lambda m: m.name):
+            if module.name.startswith("_"):
+                continue
+            try:
+                importlib.import_module(f"{self.package}.{module.name}")
+            except ImportError as exc:
+                self.unavailable[module.name] = f"missing dependency: {exc}"
+        for point in _entry_points(group=self.package):
+            try:
+                self._plug(point.load())
+            except Exception as exc:  # a broken plugin is reported, the others still load
+                self.unavailable[point.name] = f"plugin {point.value}: {type(exc).__name__}: {exc}"
+
+    def _load_one(self, name: str) -> None:
+        """Import the built-in module called ``name``, or the plugin of that name, if any."""
+        if self._loaded or not name.isidentifier() or name.startswith("_"):
+            return
+        module = f"{self.package}.{name}"
+        try:
+            if importlib.util.find_spec(module) is not None:
+                importlib.import_module(module)
+                return
+        except ImportError:
+            return  # the full load records why
+        for point in _entry_points(group=self.package, name=name):
+            try:
+                self._plug(point.load())
+            except Exception:  # the full load records why
+                return
+
+    def _plug(self, loaded: object) -> None:
+        """Register what an entry point names: a module registered itself on import."""
+        if inspect.ismodule(loaded):
+            return
+        kind = loaded if inspect.isclass(loaded) else type(loaded)
+        name = getattr(loaded, "name", None)
+        if not isinstance(name, str):
+            raise TypeError(f"{loaded!r} is neither a module nor a {self.kind} with a name")
+        if isinstance(self._entries.get(name), kind):
+            return  # its module registered it when the entry point imported it
+        self.register(loaded() if inspect.isclass(loaded) else loaded)
+
+    def get(self, name: str | Entry) -> Entry:  # type: ignore[override]
+        """Return the entry called ``name`` (an entry is returned as it is).
+
+        Unlike a dict's ``get``, an unknown name is an error: a misspelled law or scene never
+        passes silently as None.
+
+        Raises
+        ------
+        UnknownName
+            For an unknown name; the message lists the known ones.
+        """
+        if not isinstance(name, str):
+            return name
+        return self[name]
+
+    def __getitem__(self, name: str) -> Entry:
+        if name not in self._entries:
+            self._load_one(name)
+        if name not in self._entries:
+            self._load()
+        try:
+            return self._entries[name]
+        except KeyError:
+            known = ", ".join(self.names())
+            reason = self.unavailable.get(name)
+            extra = f" ({reason})" if reason else ""
+            raise UnknownName(f"unknown {self.kind} {name!r}{extra}; known: {known}") from None
+
+    def names(self) -> list[str]:
+        """Registered names, sorted."""
+        self._load()
+        return sorted(self._entries)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.names())
+
+    def __len__(self) -> int:
+        return len(self.names())
+
+    def __contains__(self, name: object) -> bool:
+        self._load()
+        return name in self._entries
+
+    def __repr__(self) -> str:
+        return f"<{self.kind} registry: {', '.join(self.names())}>"

@@ -1,0 +1,69 @@
+"""Tags: what a law can treat and what a scene requires, in one type.
+
+A law's tags say which features of a problem it treats (friction, several contacts, spatial
+contacts), whether it reads contact stiffness, and which option is its accuracy knob. A scene's
+tags say which of those features its problems have. A law can be given a scene when its tags
+cover the scene's (`Tags.missing` is empty), and a problem when `Tags.refusal` is None.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from lawbench.core.problem import ImpactProblem
+
+# The features a scene can require and a law can treat, with their words for messages.
+FEATURES = {
+    "friction": "friction",
+    "several_contacts": "several contacts",
+    "spatial": "spatial contacts",
+}
+
+
+@dataclass(frozen=True)
+class Tags:
+    """Features of a law (what it treats) or of a scene (what it requires).
+
+    Attributes
+    ----------
+    friction : bool
+        Coulomb friction: a tangential Jacobian and mu > 0.
+    several_contacts : bool
+        More than one contact in one impact.
+    spatial : bool
+        Spatial contacts (two tangential directions).
+    stiffness : bool
+        A law reads the contacts' stiffness and exponent; a scene's outcome depends on them.
+    accuracy_knob : str or None
+        For a law, the option that trades accuracy for cost; None for exact laws.
+    """
+
+    friction: bool = False
+    several_contacts: bool = False
+    spatial: bool = False
+    stiffness: bool = False
+    accuracy_knob: str | None = None
+
+    def missing(self, required: Tags) -> list[str]:
+        """The features ``required`` has and these tags do not treat, in words."""
+        return [
+            word
+            for name, word in FEATURES.items()
+            if getattr(required, name) and not getattr(self, name)
+        ]
+
+    def covers(self, required: Tags) -> bool:
+        """Whether a law with these tags treats every feature ``required`` names."""
+        return not self.missing(required)
+
+    def refusal(self, problem: ImpactProblem) -> str | None:
+        """Why a law with these tags cannot treat ``problem``, or None."""
+        if problem.frictional and not self.friction:
+            return "the problem has friction (mu > 0) and this law is frictionless"
+        if problem.d == 2 and problem.frictional and not self.spatial:
+            return "the problem is spatial (two tangential directions) and this law is planar"
+        if problem.closed_count > 1 and not self.several_contacts:
+            return f"the problem has {problem.closed_count} closed contacts and this law treats one"
+        return None

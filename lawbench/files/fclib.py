@@ -1,0 +1,218 @@
+"""FCLIB files (the frictional-contact problem library of Siconos and others) as impact problems.
+
+FCLIB stores 3D (or 2D) frictional contact problems in HDF5 (Acary, Brémond, Koziara, Pérignon,
+"FCLIB: a collection of discrete 3D frictional contact problems", 2014; the library's
+``fclib.h``). Per contact the local coordinates are (normal, tangent 1[, tangent 2]); ``mu``
+has one entry per contact; ``spacedim`` is 3 (or 2).
+
+- Local form ``/fclib_local``: a positive semidefinite Delassus matrix ``W`` and a vector
+  ``q``; find ``u = W r + q`` and ``r`` in the Coulomb cones with De Saxce's complementarity
+  ``C*_mu ∋ u + (mu |u_T|, 0, 0) ⊥ r ∈ C_mu``.
+- Global form ``/fclib_global``: ``M v = H r + f``, ``u = H.T v + w`` and the same cone
+  complementarity (``G``, ``b``: equality constraints, not read here).
+
+As an impact with ``e = 0`` this is exactly Moreau's law with Coulomb cones: the impulses are
+``r``, the post-impact local velocities ``u``. The global form maps to ``M``, ``W = H``
+(normal columns ``Wn``, tangential ``Wt``) and the pre-impact velocity ``v- = M^-1 f``; an
+offset ``w`` has no counterpart in an impact problem and is refused. The local form has no
+generalized coordinates: they are built from the eigendecomposition ``W = V diag(l) V.T``,
+keeping the ``k`` positive eigenvalues, with ``M = I_k``, contact Jacobian
+``Wc = diag(sqrt(l)) V.T`` (so ``Wc.T Wc = W``, singular ``W`` included) and ``v- = Wc^+ q``;
+a ``q`` outside the range of ``W`` is refused.
+
+Matrices are read in any of FCLIB's sparse layouts (``nz = -1`` compressed columns, ``-2``
+compressed rows, ``>= 0`` triplets) and written as compressed columns. HDF5 needs h5py.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.sparse
+
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.problem import ImpactProblem
+from lawbench.files.hdf5 import require_h5py
+
+FORMS = ("local", "global")
+
+
+def is_fclib(path: str | Path) -> bool:
+    """Whether ``path`` is an HDF5 file holding an FCLIB problem."""
+    try:
+        with require_h5py().File(path, "r") as handle:
+            return any(f"fclib_{form}" in handle for form in FORMS)
+    except OSError:
+        return False
+
+
+def _read_matrix(group: Any, where: str) -> np.ndarray:
+    def number(key: str) -> int:
+        if key not in group:
+            raise InvalidProblem(f"{where}/{key} is missing")
+        return int(np.asarray(group[key][()]).ravel()[0])
+
+    m, n, nz = number("m"), number("n"), number("nz")
+    p, i, x = (np.asarray(group[key][()]) if key in group else None for key in ("p", "i", "x"))
+    if p is None or i is None or x is None:
+        raise InvalidProblem(f"{where}: p, i and x are needed")
+    if nz == -1:
+        matrix = scipy.sparse.csc_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n))
+    elif nz == -2:
+        matrix = scipy.sparse.csr_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n))
+    elif nz >= 0:
+        matrix = scipy.sparse.coo_matrix((x[:nz], (p[:nz], i[:nz])), shape=(m, n))
+    else:
+        raise InvalidProblem(f"{where}/nz = {nz}: not an FCLIB sparse layout (-2, -1 or >= 0)")
+    return matrix.toarray()
+
+
+def _write_matrix(group: Any, matrix: np.ndarray) -> None:
+    csc = scipy.sparse.csc_matrix(matrix)
+    for key, value in (("nzmax", csc.nnz), ("m", csc.shape[0]), ("n", csc.shape[1]), ("nz", -1)):
+        group.create_dataset(key, data=np.array([value], dtype=np.int32))
+    group.create_dataset("p", data=csc.indptr.astype(np.int32))
+    group.create_dataset("i", data=csc.indices.astype(np.int32))
+    group.create_dataset("x", data=csc.data.astype(float))
+
+
+def _vector(group: Any, key: str, where: str) -> np.ndarray:
+    if key not in group:
+        raise InvalidProblem(f"{where}/{key} is missing")
+    return np.asarray(group[key][()], dtype=float).ravel()
+
+
+def _split(W: np.ndarray, dim: int, mu: np.ndarray, where: str) -> dict[str, Any]:
+    """Normal and tangential columns from FCLIB's per-contact (n, t1[, t2]) order."""
+    if W.shape[1] % dim or W.shape[1] // dim != mu.size:
+        raise InvalidProblem(
+            f"{where}: {W.shape[1]} local coordinates for {mu.size} contacts of dimension {dim}"
+        )
+    Wn = W[:, 0::dim]
+    Wt = np.stack([W[:, k::dim] for k in range(1, dim)], axis=2).reshape(W.shape[0], -1)
+    return {"Wn": Wn, "Wt": Wt}
+
+
+def _local_order(problem: ImpactProblem) -> np.ndarray:
+    """The columns of ``[Wn, Wt]`` in FCLIB's per-contact order (n, t1, t2)."""
+    m, d = problem.m, problem.d
+    return np.array(
+        [column for j in range(m) for column in (j, *(m + j * d + k for k in range(d)))]
+    )
+
+
+def read_fclib(path: str | Path) -> ImpactProblem:
+    """Read an FCLIB file (local or global form) as an impact problem with ``e = 0``.
+
+    Raises
+    ------
+    InvalidProblem
+        For a file that is not FCLIB, a missing field, a form this mapping cannot represent
+        (equality constraints, an offset ``w``, ``q`` outside the range of ``W``), or a bad
+        field of the resulting problem; the message names the field.
+    """
+    where = str(path)
+    try:
+        handle = require_h5py().File(path, "r")
+    except OSError as exc:
+        raise InvalidProblem(f"{where}: cannot be read as HDF5 ({exc})") from None
+    with handle:
+        if "fclib_global" in handle:
+            root, form = handle["fclib_global"], "global"
+        elif "fclib_local" in handle:
+            root, form = handle["fclib_local"], "local"
+        else:
+            raise InvalidProblem(f"{where}: neither /fclib_local nor /fclib_global")
+        where = f"{where}:/fclib_{form}"
+        dim = int(np.asarray(root["spacedim"][()]).ravel()[0]) if "spacedim" in root else 3
+        if dim not in (2, 3):
+            raise InvalidProblem(f"{where}/spacedim = {dim}: must be 2 or 3")
+        if "vectors" not in root:
+            raise InvalidProblem(f"{where}/vectors is missing")
+        vectors = root["vectors"]
+        mu = _vector(vectors, "mu", f"{where}/vectors")
+        if form == "global":
+            if "G" in root:
+                raise InvalidProblem(f"{where}/G: equality constraints are not an impact problem")
+            M = _read_matrix(root["M"], f"{where}/M")
+            H = _read_matrix(root["H"], f"{where}/H")
+            f = _vector(vectors, "f", f"{where}/vectors")
+            w = _vector(vectors, "w", f"{where}/vectors")
+            if np.any(w):
+                raise InvalidProblem(
+                    f"{where}/vectors/w: a constant local velocity has no impact counterpart"
+                )
+            columns, v = H, _solve(M, f, where)
+        else:
+            if "V" in root or "R" in root:
+                raise InvalidProblem(f"{where}/V, R: mixed problems are not an impact problem")
+            W = _read_matrix(root["W"], f"{where}/W")
+            q = _vector(vectors, "q", f"{where}/vectors")
+            M, columns, v = _coordinates(W, q, where)
+    try:
+        return ImpactProblem.from_arrays(M, v=v, **_split(columns, dim, mu, where), e=0.0, mu=mu)
+    except InvalidProblem as exc:
+        raise InvalidProblem(f"{where}: {exc}") from None
+
+
+def _solve(M: np.ndarray, f: np.ndarray, where: str) -> np.ndarray:
+    try:
+        return np.linalg.solve(M, f)
+    except np.linalg.LinAlgError:
+        raise InvalidProblem(f"{where}/M is singular") from None
+
+
+def _coordinates(W: np.ndarray, q: np.ndarray, where: str) -> tuple[np.ndarray, ...]:
+    """``M = I``, ``Wc`` with ``Wc.T Wc = W`` and ``v`` with ``Wc.T v = q``, from W's spectrum."""
+    W = (W + W.T) / 2
+    values, vectors = np.linalg.eigh(W)
+    keep = values > 1e-12 * max(values.max(), 0.0)
+    if not keep.any():
+        raise InvalidProblem(f"{where}/W has no positive eigenvalue")
+    Wc = np.sqrt(values[keep])[:, None] * vectors[:, keep].T
+    v, *_ = np.linalg.lstsq(Wc.T, q, rcond=None)
+    if np.abs(Wc.T @ v - q).max() > 1e-9 * max(np.abs(q).max(), 1e-300):
+        raise InvalidProblem(f"{where}/vectors/q lies outside the range of W")
+    return np.eye(int(keep.sum())), Wc, v
+
+
+def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -> Path:
+    """Write ``problem`` as an FCLIB file: its contact Delassus matrix (local) or M, H (global).
+
+    The restitution coefficients are not part of FCLIB (its problems are impacts with
+    ``e = 0``); a frictionless problem is written with spatial dimension 2 and ``mu = 0``.
+
+    Raises
+    ------
+    InvalidProblem
+        For an unknown form or a file that cannot be written.
+    """
+    if form not in FORMS:
+        raise InvalidProblem(f"FCLIB form {form!r}: must be one of {', '.join(FORMS)}")
+    path = Path(path)
+    if problem.Wt is None:
+        W = np.zeros((problem.n, 2 * problem.m))
+        W[:, 0::2] = problem.Wn
+        dim = 2
+    else:
+        W, dim = problem.W[:, _local_order(problem)], problem.d + 1
+    try:
+        handle = require_h5py().File(path, "w")
+    except OSError as exc:
+        raise InvalidProblem(f"{path}: cannot be written ({exc})") from None
+    with handle:
+        root = handle.create_group(f"fclib_{form}")
+        root.create_dataset("spacedim", data=np.array([dim], dtype=np.int32))
+        vectors = root.create_group("vectors")
+        vectors.create_dataset("mu", data=problem.mu)
+        if form == "local":
+            _write_matrix(root.create_group("W"), W.T @ problem.solve_mass(W))
+            vectors.create_dataset("q", data=W.T @ problem.v)
+        else:
+            _write_matrix(root.create_group("M"), problem.M)
+            _write_matrix(root.create_group("H"), W)
+            vectors.create_dataset("f", data=problem.M @ problem.v)
+            vectors.create_dataset("w", data=np.zeros(W.shape[1]))
+    return path

@@ -1,0 +1,284 @@
+"""Impact problems in files: a documented, versioned format in JSON, NPZ or HDF5.
+
+The format (version 1) holds one `ImpactProblem`:
+
+| key | content |
+| --- | --- |
+| ``format`` | ``"lawbench-problem"`` |
+| ``version`` | ``1`` |
+| ``M`` | (n, n) mass matrix |
+| ``Wn`` | (n, m) normal Jacobian, ``un = Wn.T @ v`` |
+| ``Wt`` | (n, m*d) tangential Jacobian, absent without friction |
+| ``v`` | (n,) pre-impact velocity |
+| ``gaps`` | (m,) initial gaps |
+| ``bodies`` | body name -> indices of its coordinates |
+| ``contacts`` | one entry per contact: every field of `lawbench.Contact` (null where unset) |
+
+Sign conventions as everywhere in lawbench: ``un < 0`` approaches, ``Pn >= 0`` pushes apart,
+``v_plus = v + M^-1 (Wn Pn + Wt Pt)``.
+
+The extension decides the encoding. ``.json`` is readable: matrices are nested lists of numbers
+written with Python's shortest round-trip repr, so every float is read back bit for bit.
+``.npz`` and ``.h5``/``.hdf5`` hold arrays; a matrix whose entries are mostly zero (sparse
+chains) is stored as CSR triplets (``<name>.data``, ``.indices``, ``.indptr``, ``.shape``), so a
+large sparse problem stays small on disk. A problem built with scipy.sparse matrices is marked
+``sparse`` (true) and read back with them; JSON writes its matrices dense. ``bodies`` and
+``contacts`` are stored as JSON text in the array files. HDF5 needs h5py
+(``pip install 'lawbench[hdf5]'``).
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.sparse
+
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.problem import Contact, ImpactProblem, is_sparse
+from lawbench.files.hdf5 import require_h5py
+
+FORMAT, VERSION = "lawbench-problem", 1
+MATRICES = ("M", "Wn", "Wt", "v", "gaps")
+# A matrix is stored as CSR when at most this share of its entries is non-zero.
+SPARSE_SHARE = 0.25
+CONTACT_FIELDS = tuple(Contact.__dataclass_fields__)
+
+
+def to_dict(problem: ImpactProblem) -> dict[str, Any]:
+    """The problem as plain data (arrays as numpy arrays)."""
+    data: dict[str, Any] = {"format": FORMAT, "version": VERSION}
+    for name in MATRICES:
+        value = getattr(problem, name)
+        if value is not None:
+            data[name] = value if is_sparse(value) else np.array(value)
+    data["bodies"] = {name: list(idx) for name, idx in problem.bodies.items()}
+    data["contacts"] = [{f: getattr(c, f) for f in CONTACT_FIELDS} for c in problem.contacts]
+    return data
+
+
+def from_dict(data: Mapping[str, Any], where: str = "problem") -> ImpactProblem:
+    """Build a problem from plain data, checking the format, version and every field.
+
+    Raises
+    ------
+    InvalidProblem
+        Naming ``where`` and the field.
+    """
+    if data.get("format") != FORMAT:
+        raise InvalidProblem(f"{where}: format is {data.get('format')!r}, expected {FORMAT!r}")
+    if data.get("version") != VERSION:
+        raise InvalidProblem(f"{where}: version {data.get('version')!r} is not supported (1)")
+    for name in ("M", "Wn", "v", "contacts"):
+        if name not in data:
+            raise InvalidProblem(f"{where}: field {name!r} is missing")
+    contacts = data["contacts"]
+    if not isinstance(contacts, list) or not all(isinstance(c, Mapping) for c in contacts):
+        raise InvalidProblem(f"{where}: contacts must be a list of objects")
+    parsed = []
+    for j, contact in enumerate(contacts):
+        unknown = sorted(set(contact) - set(CONTACT_FIELDS))
+        if unknown:
+            raise InvalidProblem(f"{where}: contacts[{j}].{unknown[0]} is not a contact field")
+        for name, value in contact.items():
+            if value is not None and (
+                isinstance(value, bool) or not isinstance(value, int | float)
+            ):
+                raise InvalidProblem(f"{where}: contacts[{j}].{name} = {value!r}: not a number")
+        parsed.append(Contact(**contact))
+    bodies = data.get("bodies", {})
+    if not isinstance(bodies, Mapping):
+        raise InvalidProblem(f"{where}: bodies must map names to index lists")
+    try:
+        return ImpactProblem(
+            M=data["M"],
+            Wn=data["Wn"],
+            v=data["v"],
+            contacts=parsed,
+            Wt=data.get("Wt"),
+            bodies=bodies,
+            gaps=data.get("gaps"),
+        )
+    except InvalidProblem as exc:
+        raise InvalidProblem(f"{where}: {exc}") from None
+
+
+def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
+    """Write ``problem`` to ``path`` in the encoding its extension names; return the path.
+
+    Raises
+    ------
+    InvalidProblem
+        For an unknown extension, or a file that cannot be written.
+    """
+    path = Path(path)
+    writer = _codec(path)[0]
+    try:
+        writer(to_dict(problem), path)
+    except OSError as exc:
+        raise InvalidProblem(f"{path}: cannot be written ({exc.strerror or exc})") from None
+    return path
+
+
+def load_problem(path: str | Path) -> ImpactProblem:
+    """Read a problem written by `save_problem` (or by hand, in the same format).
+
+    An HDF5 file holding an FCLIB problem is read as one (`lawbench.files.fclib.read_fclib`).
+
+    Raises
+    ------
+    InvalidProblem
+        For an unknown extension, an unreadable or malformed file, or a bad field; the
+        message names the file and the field.
+    """
+    path = Path(path)
+    reader = _codec(path)[1]
+    if reader is _read_hdf5:
+        from lawbench.files.fclib import is_fclib, read_fclib
+
+        if is_fclib(path):
+            return read_fclib(path)
+    try:
+        data = reader(path)
+    except InvalidProblem:
+        raise
+    except OSError as exc:
+        raise InvalidProblem(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    except (ValueError, KeyError, TypeError, zipfile.BadZipFile) as exc:
+        raise InvalidProblem(f"{path}: not a lawbench problem file ({exc})") from None
+    return from_dict(data, str(path))
+
+
+def _json_default(value: Any) -> Any:
+    if is_sparse(value):
+        value = value.toarray()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"cannot write {type(value).__name__}")
+
+
+def _write_json(data: dict[str, Any], path: Path) -> None:
+    path.write_text(json.dumps(data, default=_json_default, indent=1, allow_nan=False) + "\n")
+
+
+def _read_json(path: Path) -> dict[str, Any]:
+    try:
+        data = json.loads(path.read_text(), parse_constant=_reject_constant)
+    except json.JSONDecodeError as exc:
+        raise InvalidProblem(f"{path}: malformed JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise InvalidProblem(f"{path}: expected a JSON object")
+    return data
+
+
+def _reject_constant(name: str) -> float:
+    raise InvalidProblem(f"{name} is not a finite number")
+
+
+def _arrays(data: dict[str, Any]) -> dict[str, np.ndarray]:
+    """Flat arrays for NPZ and HDF5: dense, or CSR triplets for mostly-zero matrices.
+
+    ``sparse`` marks a problem given with scipy.sparse matrices, read back as one.
+    """
+    arrays: dict[str, np.ndarray] = {
+        "format": np.array(FORMAT),
+        "version": np.array(VERSION),
+        "bodies": np.array(json.dumps(data["bodies"])),
+        "contacts": np.array(json.dumps(data["contacts"])),
+    }
+    if is_sparse(data["M"]):
+        arrays["sparse"] = np.array(True)
+    for name in MATRICES:
+        if name not in data:
+            continue
+        value = data[name]
+        if is_sparse(value) or (
+            value.ndim == 2
+            and value.size > 64
+            and np.count_nonzero(value) <= SPARSE_SHARE * value.size
+        ):
+            csr = scipy.sparse.csr_matrix(value)
+            arrays |= {
+                f"{name}.data": csr.data,
+                f"{name}.indices": csr.indices,
+                f"{name}.indptr": csr.indptr,
+                f"{name}.shape": np.array(csr.shape),
+            }
+        else:
+            arrays[name] = value
+    return arrays
+
+
+def _from_arrays(get: Callable[[str], Any], names: set[str]) -> dict[str, Any]:
+    """Plain data from the flat arrays of an NPZ or HDF5 file."""
+    data: dict[str, Any] = {}
+    for key in ("format", "version"):
+        if key in names:
+            value = np.asarray(get(key)).item()
+            data[key] = value.decode() if isinstance(value, bytes) else value
+    for key in ("bodies", "contacts"):
+        if key in names:
+            text = np.asarray(get(key)).item()
+            data[key] = json.loads(text.decode() if isinstance(text, bytes) else text)
+    sparse = "sparse" in names and bool(np.asarray(get("sparse")))
+    for name in MATRICES:
+        if name in names:
+            data[name] = np.asarray(get(name))
+        elif f"{name}.data" in names:
+            shape = tuple(int(s) for s in np.asarray(get(f"{name}.shape")))
+            matrix = scipy.sparse.csr_matrix(
+                (get(f"{name}.data"), get(f"{name}.indices"), get(f"{name}.indptr")), shape
+            )
+            data[name] = matrix if sparse else matrix.toarray()
+    return data
+
+
+def _write_npz(data: dict[str, Any], path: Path) -> None:
+    with path.open("wb") as handle:
+        np.savez_compressed(handle, **_arrays(data))
+
+
+def _read_npz(path: Path) -> dict[str, Any]:
+    with np.load(path, allow_pickle=False) as archive:
+        return _from_arrays(lambda key: archive[key], set(archive.files))
+
+
+def _write_hdf5(data: dict[str, Any], path: Path) -> None:
+    with require_h5py().File(path, "w") as handle:
+        group = handle.create_group(FORMAT)
+        for key, value in _arrays(data).items():
+            # Text (the format tag, bodies, contacts) is stored as an HDF5 string.
+            group.create_dataset(key, data=value.item() if value.dtype.kind == "U" else value)
+
+
+def _read_hdf5(path: Path) -> dict[str, Any]:
+    with require_h5py().File(path, "r") as handle:
+        if FORMAT not in handle:
+            raise InvalidProblem(f"{path}: no group {FORMAT!r} (not a lawbench problem file)")
+        group = handle[FORMAT]
+        return _from_arrays(lambda key: group[key][()], set(group))
+
+
+CODECS: dict[str, tuple[Callable, Callable]] = {
+    ".json": (_write_json, _read_json),
+    ".npz": (_write_npz, _read_npz),
+    ".h5": (_write_hdf5, _read_hdf5),
+    ".hdf5": (_write_hdf5, _read_hdf5),
+}
+
+
+def _codec(path: Path) -> tuple[Callable, Callable]:
+    try:
+        return CODECS[path.suffix.lower()]
+    except KeyError:
+        known = ", ".join(CODECS)
+        raise InvalidProblem(f"{path}: unknown extension {path.suffix!r}; known: {known}") from None
+
+
+__all__ = ["from_dict", "load_problem", "save_problem", "to_dict"]

@@ -1,0 +1,8 @@
+"""The study engine: runs every declared study and grid, and keeps what it found.
+
+Owns grids and run files, the executor (serial, processes, Dask) with its per-job guard, the
+tidy table of a run and its on-disk store, the regression baselines, the fit of a law's
+coefficients to measurements, the conformance check of any law (`check_law`) and the
+benchmark. May import the core, numerics, files, checks, and the laws and cases (through
+their registries); never a view.
+"""

@@ -1,0 +1,421 @@
+"""``lawbench bench``: the cost of an answer, as ratios against direct solver calls in one run.
+
+Each figure is the fastest of several repetitions (on a shared machine noise only ever adds
+time, so the fastest is the steadiest figure of the code itself, as timeit advises), measured in
+this process (or as whole processes for the start-up figure), beside a peer measured in the
+same run and timed the same way: clarabel called
+directly on the same QP (the impulses' LCP as ``min z.G z / 2 + q.z, z >= 0``, sparse), a
+plain numpy enumeration of the same LCP's active sets, and Siconos numerics' Lemke solver where
+it is installed (``LAWBENCH_SICONOS_PYTHON``, default ``/usr/bin/python3`` with Debian's
+python3-siconos). Ratios, not absolute times, are what
+carry from one machine to another. This is a benchmark: nothing here asserts a time.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from typing import Any
+
+import clarabel
+import numpy as np
+import scipy.sparse
+
+from lawbench.core.batch import ProblemBatch
+from lawbench.core.case import CASES
+from lawbench.core.errors import InvalidProblem, SolverFailure
+from lawbench.core.law import LAWS
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.registry import Registry
+from lawbench.core.trial import solve_batch
+from lawbench.numerics.chains import chain_problem
+from lawbench.numerics.solvers import clarabel_settings, enumerate_lcp
+
+# The roles laws and scenes declare (``bench_roles``) to be the bench's subjects:
+ROLES = {
+    # the law whose impulses solve the frictionless LCP ``0 <= G z + q _|_ z >= 0`` that the
+    # peers (clarabel, the numpy enumeration, Siconos' Lemke) solve;
+    "lcp": "the law timed against the LCP peers",
+    # the law and the scene of the small command whose start-up is timed.
+    "start_up": "the law and scene of the timed start-up command",
+}
+
+
+def subject(registry: Registry, role: str) -> str:
+    """The name of the first entry of ``registry`` (by name) that declares ``role``.
+
+    Raises
+    ------
+    InvalidProblem
+        When no entry declares it.
+    """
+    for name, entry in registry.items():
+        if role in entry.bench_roles:
+            return name
+    raise InvalidProblem(f"no {registry.kind} declares the bench role {role!r} ({ROLES[role]})")
+
+
+def start_up_command() -> tuple[str, ...]:
+    """The small command whose start-up is timed: ``solve LAW SCENE`` of the start-up role."""
+    return ("solve", subject(LAWS, "start_up"), subject(CASES, "start_up"))
+
+
+# Chain lengths of the full report: the growth from 1,000 to 10,000 balls shows the cost per ball.
+CHAINS = (100, 1000, 10_000)
+
+
+# The integrating laws (those that restart at events: option ``max_events``) on elastic Hertz
+# chains: sizes, the tolerance that keeps a 1000-ball chain's energy to 1e-9, and the
+# wall-clock budget of one run.
+INTEGRATING_SIZES, QUICK_INTEGRATING_SIZES = (100, 1000), (20, 40)
+INTEGRATING_TOL, INTEGRATING_BUDGET_S = 1e-12, 120.0
+
+
+def best_time(function: Callable[[], Any], repeats: int, number: int = 1) -> float:
+    """Fastest over ``repeats`` of the mean wall time of ``number`` calls, in seconds."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(number):
+            function()
+        times.append((time.perf_counter() - start) / number)
+    return min(times)
+
+
+def alternated(
+    measures: dict[str, Callable[[], float | None]], rounds: int
+) -> dict[str, float | None]:
+    """The fastest of each measure over ``rounds`` rounds that take every measure in turn.
+
+    The machine's speed drifts within a run (the same pure-Python loop took 3.9 ms to 7.3 ms
+    here): alternating lets both sides of a ratio meet it in the same states. A measure that
+    fails (None) once is None.
+    """
+    best: dict[str, float | None] = dict.fromkeys(measures, math.inf)
+    for _ in range(rounds):
+        for name, measure in measures.items():
+            seconds, so_far = measure(), best[name]
+            best[name] = None if seconds is None or so_far is None else min(so_far, seconds)
+    return best
+
+
+def chain_arrays(balls: int, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
+    """Masses, normal Jacobian and velocities of a free chain with every contact approaching."""
+    masses = 10.0 ** rng.uniform(-1.0, 1.0, balls)
+    Wn = np.zeros((balls, balls - 1))
+    index = np.arange(balls - 1)
+    Wn[index, index], Wn[index + 1, index] = -1.0, 1.0
+    v = np.sort(rng.uniform(0.0, 1.0, balls))[::-1].copy()
+    return np.diag(masses), Wn, v
+
+
+def clarabel_direct(M: Any, Wn: Any, v: np.ndarray, e: float) -> np.ndarray:
+    """Moreau's frictionless impulses with clarabel, called directly on the sparse LCP's QP.
+
+    ``M`` (diagonal) and ``Wn`` are numpy or scipy.sparse arrays.
+    """
+    Wn_sparse = scipy.sparse.csc_matrix(Wn)
+    inverse_mass = scipy.sparse.diags(1.0 / M.diagonal())
+    G = (Wn_sparse.T @ inverse_mass @ Wn_sparse).tocsc()
+    q = (1.0 + e) * (Wn.T @ v)
+    m = Wn.shape[1]
+    solver = clarabel.DefaultSolver(
+        scipy.sparse.triu(G).tocsc(),
+        q,
+        -scipy.sparse.identity(m, format="csc"),
+        np.zeros(m),
+        [clarabel.NonnegativeConeT(m)],
+        clarabel_settings(1e-10, 200),
+    )
+    return np.array(solver.solve().x)
+
+
+def numpy_enumeration(M: np.ndarray, Wn: np.ndarray, v: np.ndarray, e: float) -> np.ndarray:
+    """The same impulses by plain active-set enumeration, with G and q built in numpy."""
+    G = Wn.T @ np.linalg.solve(M, Wn)
+    return enumerate_lcp(G, (1.0 + e) * (Wn.T @ v))[0]
+
+
+# Siconos numerics (the reference nonsmooth-mechanics library, C) is measured when the
+# interpreter below imports it (Debian: python3-siconos): Lemke on the same chain's LCP (its
+# matrix is dense), building its matrix and vector included, ``number`` calls at a time.
+SICONOS_PYTHON = os.environ.get("LAWBENCH_SICONOS_PYTHON", "/usr/bin/python3")
+SICONOS_SETUP = """
+import numpy as np, siconos.numerics as sn
+masses, v, e = np.array({masses}), np.array({v}), {e}
+n = len(masses); index = np.arange(n - 1)
+Wn = np.zeros((n, n - 1)); Wn[index, index] = -1.0; Wn[index + 1, index] = 1.0
+def one():
+    D = Wn.T @ (Wn / masses[:, None]); q = (1.0 + e) * (Wn.T @ v)
+    z, w = np.zeros(n - 1), np.zeros(n - 1)
+    sn.lcp_lexicolemke(sn.LCP(D, q), z, w, sn.SolverOptions(sn.SICONOS_LCP_LEMKE))
+    return z
+"""
+
+# A pure-Python loop timed in two interpreters: a small impact is bound by the interpreter
+# (its calls, not its arithmetic), so the ratio of the two times is the part of a ratio
+# against Siconos that comes from running on another build of CPython.
+PYTHON_LOOP_SETUP = """
+def one():
+    total = 0
+    for i in range(100_000):
+        total += i * i
+    return total
+"""
+
+# How another interpreter times ``one()`` of a setup: the fastest of ``repeats`` means of
+# ``number`` calls, after WARM_UP_S seconds of calls (timed at once, a fresh process ran a
+# few thousand Lemke solves at two thirds of their steady speed here: 10 us instead of 6.6 us).
+WARM_UP_S = 0.3
+TIMED = """
+import time
+warm = time.perf_counter() + {warm_up}
+while time.perf_counter() < warm: one()
+times = []
+for _ in range({repeats}):
+    start = time.perf_counter()
+    for _ in range({number}): one()
+    times.append((time.perf_counter() - start) / {number})
+print(min(times))
+"""
+
+
+def siconos_lemke(
+    masses: np.ndarray, v: np.ndarray, repeats: int, number: int = 200, e: float = 0.9
+) -> float | None:
+    """Fastest seconds per Lemke solve of a free chain in Siconos numerics, or None if absent."""
+    setup = SICONOS_SETUP.format(masses=masses.tolist(), v=v.tolist(), e=e)
+    return _seconds_of_one(SICONOS_PYTHON, setup, repeats, number)
+
+
+def python_loop(python: str, repeats: int) -> float | None:
+    """Fastest seconds of a pure-Python loop in the interpreter ``python``, or None if absent."""
+    return _seconds_of_one(python, PYTHON_LOOP_SETUP, repeats, 1)
+
+
+def _seconds_of_one(python: str, setup: str, repeats: int, number: int) -> float | None:
+    """Seconds per call of ``one()`` defined by ``setup``, timed by ``python``; None if it fails."""
+    script = setup + TIMED.format(warm_up=WARM_UP_S, repeats=repeats, number=number)
+    try:
+        done = subprocess.run([python, "-c", script], capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return float(done.stdout) if done.returncode == 0 else None
+
+
+def _row(label: str, seconds: float, peers: dict[str, float]) -> str:
+    ratios = ", ".join(f"{seconds / t:.3g}x {name}" for name, t in peers.items())
+    return f"  {label:<46}{_time(seconds):>12}   {ratios}"
+
+
+def _time(seconds: float) -> str:
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.1f} us"
+    return f"{seconds * 1e3:.2f} ms" if seconds < 1 else f"{seconds:.2f} s"
+
+
+def small_impact(repeats: int, rounds: int = 3) -> list[str]:
+    """One three-ball impact of the ``lcp`` law: from a prebuilt problem, and from matrices.
+
+    lawbench's two figures, Siconos' and the pure-Python loop in both interpreters are taken in
+    ``rounds`` `alternated` rounds.
+    """
+    M, Wn, v = chain_arrays(3, np.random.default_rng(0))
+    law = LAWS[subject(LAWS, "lcp")]
+    problem = ImpactProblem.from_arrays(M, Wn, v, e=0.9)
+    peers = {
+        "clarabel direct": best_time(lambda: clarabel_direct(M, Wn, v, 0.9), repeats, 200),
+        "numpy enumeration": best_time(lambda: numpy_enumeration(M, Wn, v, 0.9), repeats, 200),
+    }
+    measures: dict[str, Callable[[], float | None]] = {
+        "prebuilt": lambda: best_time(lambda: law.resolve(problem), repeats, 1000),
+        "built": lambda: best_time(
+            lambda: law.resolve(ImpactProblem.from_arrays(M, Wn, v, e=0.9)), repeats, 1000
+        ),
+        "Siconos Lemke": lambda: siconos_lemke(np.diag(M), v, repeats, 1000),
+        "loop here": lambda: python_loop(sys.executable, repeats),
+        "loop there": lambda: python_loop(SICONOS_PYTHON, repeats),
+    }
+    best = alternated(measures, rounds)
+    siconos = best["Siconos Lemke"]
+    if siconos is not None:
+        peers["Siconos Lemke"] = siconos
+    lines = [
+        f"one three-ball {law.name} impact (e = 0.9):",
+        _row("lawbench, prebuilt problem", best["prebuilt"], peers),
+        _row("lawbench, from matrices (problem built)", best["built"], peers),
+        *(f"  {name:<46}{_time(t):>12}" for name, t in peers.items()),
+    ]
+    if siconos is None:
+        return [*lines, "  Siconos numerics: not found (python3-siconos)"]
+    ours, theirs = best["loop here"], best["loop there"]
+    if ours is not None and theirs is not None:
+        lines.append(
+            f"  a pure-Python loop: {_time(ours)} in this interpreter (Python "
+            f"{platform.python_version()}), {_time(theirs)} in Siconos' ({SICONOS_PYTHON}): "
+            f"{ours / theirs:.2f}x"
+        )
+    return lines
+
+
+def batch_of_impacts(size: int, repeats: int) -> list[str]:
+    """A batch of random three-ball impacts against the one-by-one path and the peers."""
+    rng = np.random.default_rng(1)
+    masses = 10.0 ** rng.uniform(-1.0, 1.0, (size, 3))
+    M = np.einsum("kn,nl->knl", masses, np.eye(3))
+    _, Wn, _ = chain_arrays(3, rng)
+    v = rng.normal(size=(size, 3))
+    e = rng.uniform(0.0, 1.0, (size, 2))
+    law = LAWS[subject(LAWS, "lcp")]
+    whole = best_time(lambda: solve_batch(law, ProblemBatch(M, Wn, v, {"e": e})), repeats)
+    sample = ProblemBatch(M[:200], Wn, v[:200], {"e": e[:200]})
+    one_by_one = (
+        best_time(lambda: [law.resolve(sample.problem(k)) for k in range(200)], repeats) / 200
+    )
+    peers = {
+        "one by one": one_by_one,
+        "clarabel direct": best_time(lambda: clarabel_direct(M[0], Wn, v[0], 0.9), repeats, 200),
+    }
+    siconos = siconos_lemke(masses[0], v[0], repeats)
+    if siconos is not None:
+        peers["Siconos Lemke one by one"] = siconos
+    return [
+        f"a batch of {size:,} random three-ball {law.name} impacts (validation included):",
+        _row("lawbench solve_batch, per impact", whole / size, peers),
+    ]
+
+
+def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) -> list[str]:
+    """The ``lcp`` law on n-ball chains, built as the chain scenes build them (sparse when long).
+
+    Against clarabel called directly on the sparse QP and, up to ``siconos_up_to`` balls,
+    Siconos' Lemke on the dense LCP; the last line is the growth exponent of lawbench's time
+    between the two longest chains.
+    """
+    law = LAWS[subject(LAWS, "lcp")]
+    lines = [f"{law.name} on an n-ball chain (e = 0.5):"]
+    times = []
+    for balls in sizes:
+        rng = np.random.default_rng(balls)
+        masses = 10.0 ** rng.uniform(-1.0, 1.0, balls)
+        v = np.sort(rng.uniform(0.0, 1.0, balls))[::-1].copy()
+        ones = [1.0] * (balls - 1)
+        pairs = [(i, i + 1) for i in range(balls - 1)]
+        problem = chain_problem(masses, v, pairs, [0.5] * (balls - 1), ones, ones)
+        peers = {
+            "clarabel direct": best_time(
+                lambda p=problem: clarabel_direct(p.M, p.Wn, p.v, 0.5), repeats
+            )
+        }
+        siconos = siconos_lemke(masses, v, 3, 1, 0.5) if balls <= siconos_up_to else None
+        if siconos is not None:
+            peers["Siconos Lemke"] = siconos
+        times.append(best_time(lambda p=problem: law.resolve(p), repeats))
+        lines.append(_row(f"n = {balls}, prebuilt problem", times[-1], peers))
+    if len(sizes) > 1:
+        growth = np.log(times[-1] / times[-2]) / np.log(sizes[-1] / sizes[-2])
+        lines.append(f"  time grows like n^{growth:.2f} from n = {sizes[-2]} to {sizes[-1]}")
+    return lines
+
+
+def integrating_chains(sizes: tuple[int, ...]) -> list[str]:
+    """Each integrating law once on elastic n-ball Hertz chains, one ball striking the rest.
+
+    The laws are the registered ones that restart at events (option ``max_events``), at
+    tolerance ``INTEGRATING_TOL`` within ``INTEGRATING_BUDGET_S`` seconds. Each line gives
+    the time, the relative energy error ``|T+ - T-| / T-`` (the exact answer keeps the energy),
+    the integrator's steps, or the budget that ran out; the last line of a
+    law, the growth exponent of its time.
+    """
+    laws = [law for law in LAWS.values() if any(spec.name == "max_events" for spec in law.options)]
+    lines = ["integrating laws on an elastic n-ball Hertz chain (e = 1), one run each:"]
+    for law in laws:
+        times = []
+        for balls in sizes:
+            problem = _elastic_chain(balls)
+            start = time.perf_counter()
+            label = f"  {law.name}, n = {balls}, tol = {INTEGRATING_TOL:g}".ljust(48)
+            try:
+                outcome = law.resolve(
+                    problem, tol=INTEGRATING_TOL, max_seconds=INTEGRATING_BUDGET_S
+                )
+            except SolverFailure as failure:
+                lines.append(f"{label}{_time(time.perf_counter() - start):>12}   {failure}")
+                break
+            times.append(time.perf_counter() - start)
+            error = abs(outcome.T_plus - outcome.T_minus) / outcome.T_minus
+            lines.append(
+                f"{label}{_time(times[-1]):>12}   energy error {error:.2g}, "
+                f"{outcome.diagnostics['steps']} integrator steps"
+            )
+        if len(times) > 1:
+            growth = np.log(times[-1] / times[0]) / np.log(sizes[-1] / sizes[0])
+            lines.append(
+                f"  {law.name}: time grows like n^{growth:.2f} from n = {sizes[0]} to {sizes[-1]}"
+            )
+    return lines
+
+
+def _elastic_chain(balls: int) -> ImpactProblem:
+    """Equal balls in contact with Hertz springs, e = 1; the first strikes the others at 1 m/s."""
+    ones = [1.0] * (balls - 1)
+    pairs = [(i, i + 1) for i in range(balls - 1)]
+    velocities = [1.0] + [0.0] * (balls - 1)
+    return chain_problem([1.0] * balls, velocities, pairs, ones, ones, [1.5] * (balls - 1))
+
+
+def start_up(repeats: int) -> list[str]:
+    """Whole-process time of the small command `start_up_command` against importing numpy.
+
+    Both with their bytecode cached, as after a first run (in a temporary
+    ``PYTHONPYCACHEPREFIX``, so that nothing is written beside the sources), and, when this
+    environment sets ``PYTHONDONTWRITEBYTECODE``, as it runs them: every module that has no
+    cached bytecode (an editable install's own) compiled at every start.
+    """
+    command = start_up_command()
+    commands = {
+        "lawbench": [sys.executable, "-m", "lawbench", *command],
+        "numpy": [sys.executable, "-c", "import numpy"],
+    }
+
+    def pair(label: str, env: dict[str, str]) -> str:
+        def timed(command: list[str]) -> Callable[[], float]:
+            def run() -> None:
+                subprocess.run(command, capture_output=True, check=True, env=env)
+
+            run()  # a first run fills the cache
+            return lambda: best_time(run, 1)
+
+        best = alternated({name: timed(command) for name, command in commands.items()}, repeats)
+        return _row(label, best["lawbench"], {'python -c "import numpy"': best["numpy"]})
+
+    lines = [f"start-up, whole process, lawbench {' '.join(command)}:"]
+    with tempfile.TemporaryDirectory() as cache:
+        cached = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+        lines.append(pair("bytecode cached", {**cached, "PYTHONPYCACHEPREFIX": cache}))
+    if os.environ.get("PYTHONDONTWRITEBYTECODE"):
+        lines.append(pair("no bytecode cache (PYTHONDONTWRITEBYTECODE)", dict(os.environ)))
+    return lines
+
+
+def report(quick: bool = False) -> str:
+    """Every figure, as text."""
+    repeats = 3 if quick else 7
+    threads = {k: os.environ.get(k, "unset") for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
+    lines = [
+        f"lawbench bench on {os.cpu_count()} cores, {platform.machine()}, Python "
+        f"{platform.python_version()}, numpy {np.__version__}, clarabel {clarabel.__version__}; "
+        + ", ".join(f"{k}={v}" for k, v in threads.items()),
+        *small_impact(repeats),
+        *batch_of_impacts(10_000 if quick else 100_000, repeats),
+        *(long_chains((100, 1000), repeats) if quick else long_chains(CHAINS, repeats, 1000)),
+        *integrating_chains(QUICK_INTEGRATING_SIZES if quick else INTEGRATING_SIZES),
+        *start_up(repeats),
+    ]
+    return "\n".join(lines)

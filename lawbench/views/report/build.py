@@ -1,0 +1,151 @@
+"""Assemble the report: run every study the sections draw, then build the sections and pages.
+
+The studies run once, together, through one executor (`lawbench.views.report.runs.Context.run`);
+each section is then a view of their tables. The headline counts the *unexplained* cells of every
+table and lists each with the command that reproduces it. A section that fails is kept in the report
+with its error.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import time
+import traceback
+from importlib.metadata import version
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import matplotlib
+import numpy as np
+import pandas as pd
+import scipy
+
+from lawbench.core.verdicts import Verdict
+from lawbench.studies.guard import Guard
+from lawbench.views.report import (
+    dispersion,
+    inside,
+    outcomes,
+    paradoxes,
+    stability,
+    summary,
+    sweeps,
+    tradeoff,
+)
+from lawbench.views.report.config import Config
+from lawbench.views.report.page import Figure, Section, Table, save_figure, write_page
+from lawbench.views.report.runs import Context, label
+
+SECTIONS: tuple[ModuleType, ...] = (
+    summary,
+    outcomes,
+    tradeoff,
+    stability,
+    paradoxes,
+    dispersion,
+    inside,
+    sweeps,
+)
+TITLE = "lawbench: impact laws compared"
+# Seconds to draw one figure in a worker.
+DRAWING_S = 300.0
+
+
+def _section(module: ModuleType, ctx: Context) -> Section:
+    try:
+        return module.build(ctx)
+    except Exception as exc:  # the other sections are still worth writing
+        where = traceback.extract_tb(exc.__traceback__)[-1]
+        text = (
+            f"This section failed: {type(exc).__name__}: {exc} "
+            f"(at {Path(where.filename).name}:{where.lineno})."
+        )
+        return Section(module.ANCHOR, module.TITLE, [text])
+
+
+def build(out: Path, config: Config) -> Path:
+    """Run every study the sections draw with ``config`` and write the report into ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    ctx = Context(config, out)
+    ctx.run([view for module in SECTIONS for view in module.VIEWS])
+    sections = [_section(module, ctx) for module in SECTIONS]
+    seconds = time.perf_counter() - start
+    preamble = [*_preamble(ctx, config, seconds), *headline(ctx)]
+    write_page(out, TITLE, preamble, sections, ctx.rerun, _save(config))
+    return out
+
+
+def _save(config: Config) -> Any:
+    def save(figures: list[Figure], out: Path) -> None:
+        """Draw the figures in worker processes, all at once."""
+        with Guard(config.workers, DRAWING_S) as guard:
+            handles = [guard.submit(save_figure, f.figure, f.name, f.data, out) for f in figures]
+            for figure, handle in zip(figures, handles, strict=True):
+                result = guard.result(handle)
+                if result.status != "ok":
+                    reason = f"{result.error_class or result.status}: {result.error_message}"
+                    raise RuntimeError(f"figure {figure.name} could not be written: {reason}")
+
+    return save
+
+
+def headline(ctx: Context) -> list[Any]:
+    """The count of *unexplained* cells over every study, and each with its reproducer."""
+    rows = []
+    for study, table in ctx.every_table():
+        table = table.fillna({"error_class": ""})
+        bad = table[(table["verdict"] == str(Verdict.UNEXPLAINED)) & (table["repeat"] == 0)]
+        checks = study.check_names()
+        for row in bad.to_dict("records"):
+            if row["error_class"]:
+                why = f"{row['error_class']}: {row['error_message']}"
+            else:
+                why = "; ".join(
+                    f"{c}: {row[f'{c}_detail']}"
+                    for c in checks
+                    if row[f"{c}_verdict"] == str(Verdict.UNEXPLAINED)
+                )
+            rows.append(
+                {
+                    "study": study.name,
+                    "law": row["law"],
+                    "scene": row["case"],
+                    "cell": label(json.loads(row["params"]), skip=()) or "defaults",
+                    "why": why,
+                    "reproducer": row["reproducer"],
+                    "exit status": row["exit_status"],
+                }
+            )
+    cells = sum(len(t) for _, t in ctx.every_table())
+    if not rows:
+        return [f"No unexplained cell among the {cells} cells of {len(ctx.studies)} studies."]
+    return [
+        f"{len(rows)} unexplained cells among the {cells} cells of {len(ctx.studies)} "
+        "studies: each is a bug to fix or a finding to write. Each is listed with a command "
+        "that reruns it and exits with the status shown (0 answered, 3 refused, 4 budget or "
+        "solver failure).",
+        Table(
+            "unexplained",
+            "Every unexplained cell of the report, with why and its reproducer.",
+            pd.DataFrame(rows),
+            commands=("reproducer",),
+        ),
+    ]
+
+
+def _preamble(ctx: Context, config: Config, seconds: float) -> list[str]:
+    return [
+        f"Mode `{config.mode}`: computed in {seconds:.0f} s (before drawing the figures) "
+        f"with {config.workers} worker processes (executor `{config.executor}`; wall-clock "
+        f"guard {config.budget_s:g} s per cell). Rerun: `{ctx.rerun}`.",
+        f"Laws: {', '.join(f'`{law.name}`' for law in ctx.laws) or 'none'}. "
+        f"Scenes: {', '.join(f'`{case.name}`' for case in ctx.cases) or 'none'}. "
+        f"Studies: {', '.join(f'`{s.name}`' for s in ctx.studies) or 'none'} "
+        "(`lawbench study NAME` runs one).",
+        f"lawbench {version('lawbench')}, Python {platform.python_version()}, numpy "
+        f"{np.__version__}, scipy {scipy.__version__}, matplotlib {matplotlib.__version__}.",
+        *dict.fromkeys(f"Note: {note}." for note in ctx.notes),
+    ]

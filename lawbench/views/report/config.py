@@ -1,0 +1,64 @@
+"""What a report runs: the mode, the workers, the guard, and what to restrict it to.
+
+The report knows no scene or law by name: it runs every registered study that a section draws
+(``Study.view``), sized for the mode: ``quick`` (the default: each study as declared, slow ones
+left out, a few minutes on two cores) or ``full`` (each study's ``full`` sizes, slow ones in,
+resumable from ``OUT/runs``, on local processes or a Dask cluster). A test may shrink a preset
+with `dataclasses.replace`.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+from lawbench.core.errors import InvalidProblem
+
+MODES = ("quick", "full")
+
+
+@dataclass(frozen=True)
+class Config:
+    """Settings of one report.
+
+    Attributes
+    ----------
+    mode : str
+        'quick' or 'full' (named in the captions' rerun commands).
+    workers : int
+        Worker processes.
+    budget_s : float
+        Wall-clock guard of one cell (a solve with its checks and measures), in seconds.
+    executor : str
+        'serial', 'processes' or 'dask' (`lawbench.studies.runner.Executor`).
+    address : str or None
+        Dask scheduler address (executor 'dask'); None starts a local cluster.
+    laws, cases : tuple of str or None
+        Restrict every study to these laws and scenes; None for every registered one.
+    studies : tuple of str or None
+        Run only these studies; None for every study a section draws.
+    """
+
+    mode: str
+    workers: int
+    budget_s: float
+    executor: str = "processes"
+    address: str | None = None
+    laws: tuple[str, ...] | None = None
+    cases: tuple[str, ...] | None = None
+    studies: tuple[str, ...] | None = None
+
+    def rerun(self, out: str) -> str:
+        """The command that writes this report again."""
+        return f"lawbench report --{self.mode} --out {out}"
+
+
+QUICK = Config(mode="quick", workers=2, budget_s=60.0)
+FULL = Config(mode="full", workers=os.cpu_count() or 2, budget_s=600.0)
+
+
+def preset(mode: str) -> Config:
+    """The configuration of ``mode`` ('quick' or 'full')."""
+    if mode not in MODES:
+        raise InvalidProblem(f"report mode {mode!r}: must be one of {', '.join(MODES)}")
+    return QUICK if mode == "quick" else FULL

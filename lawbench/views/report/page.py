@@ -1,0 +1,290 @@
+"""The report as a document: sections of text, tables and figures, written as HTML and Markdown.
+
+Every table is written as CSV, every figure as PNG, SVG and the CSV of its data, all beside
+``index.html`` and ``report.md`` so the folder opens from disk without a network. The HTML page
+is a Jinja template (it escapes every value). Text uses two inline marks, the same in both
+pages: ```code``` and ``[text](target)`` links (``#anchor`` or a file of the folder). A table
+cell may hold verdict marks (`lawbench.views.report.marks.Mark`), drawn in their class's colour; a
+table can name a column whose values become the anchors of its rows (the findings list) and
+columns of commands (reproducers), shown as code.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import jinja2
+import pandas as pd
+from markupsafe import Markup, escape
+from matplotlib import rc_context
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure as MplFigure
+
+from lawbench.views.report.marks import COLOURS, GLYPHS, Mark, legend
+
+LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
+CODE = re.compile(r"`([^`]+)`")
+STYLE = """
+body { font-family: sans-serif; max-width: 1200px; margin: 2em auto; padding: 0 1em; }
+table { border-collapse: collapse; margin: 1em 0; font-size: 0.85em; }
+th, td { border: 1px solid #bbb; padding: 0.2em 0.5em; vertical-align: top; }
+th { background: #eee; }
+figure { margin: 1.5em 0; }
+figure img { max-width: 100%; }
+figcaption, .caption { font-size: 0.9em; color: #333; }
+tr:target { background: #ffd; }
+code { background: #f4f4f4; }
+.mark { display: inline-block; padding: 0 0.3em; margin: 0.05em; border-radius: 0.2em;
+        color: #000; text-decoration: none; white-space: nowrap; }
+.legend .mark { margin-right: 0.6em; }
+"""
+TEMPLATE = """<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>{{ title }}</title>
+<style>{{ style }}{% for verdict, colour in colours.items() %}
+.{{ verdict | css }} { background: {{ colour }}; }{% endfor %}</style></head>
+<body>
+<h1>{{ title }}</h1>
+{% for block in preamble %}{{ render(block) }}
+{% endfor %}<ol>{% for s in sections %}
+<li><a href="#{{ s.anchor }}">{{ s.title }}</a></li>{% endfor %}</ol>
+{% for s in sections %}<h2 id="{{ s.anchor }}">{{ s.title }}</h2>
+{% for block in s.blocks %}{{ render(block) }}
+{% endfor %}{% endfor %}</body></html>
+"""
+PARTS = {
+    "text": "<p>{{ block | inline }}</p>",
+    "legend": '<p class="legend">{% for m in block.marks %}{{ mark(m) }}'
+    "<span> {{ m.reason }}</span><br>{% endfor %}</p>",
+    "table": '<table{% if block.css %} class="{{ block.css }}"{% endif %}><thead><tr>'
+    "{% for c in block.frame.columns %}<th>{{ c }}</th>{% endfor %}</tr></thead><tbody>"
+    '{% for row in rows %}<tr{% if row.anchor %} id="{{ row.anchor }}"{% endif %}>'
+    "{% for c in row.cells %}<td>{{ c }}</td>{% endfor %}</tr>{% endfor %}</tbody></table>"
+    '<p class="caption">{{ caption | inline }}</p>',
+    "figure": '<figure id="{{ block.name }}"><a href="{{ block.name }}.svg">'
+    '<img src="{{ block.name }}.png" alt="{{ block.name }}"></a>'
+    "<figcaption>{{ caption | inline }}</figcaption></figure>",
+    "mark": '{% if m.link %}<a class="mark {{ m.verdict | css }}" href="{{ m.link }}" '
+    'title="{{ m.reason }}">{% else %}<span class="mark {{ m.verdict | css }}" '
+    'title="{{ m.reason }}">{% endif %}{{ m.text }}{{ glyph }}'
+    "{% if m.link %}</a>{% else %}</span>{% endif %}",
+}
+
+
+@dataclass
+class Table:
+    """A table: ``frame`` is shown, ``data`` (default ``frame``) is written as CSV.
+
+    ``anchors`` names a column whose values become the rows' anchors; ``commands`` the columns
+    of commands (shown as code, with the class ``reproducer``).
+    """
+
+    name: str
+    caption: str
+    frame: pd.DataFrame
+    data: pd.DataFrame | None = None
+    anchors: str | None = None
+    commands: tuple[str, ...] = ()
+    css: str = ""
+
+
+@dataclass
+class Figure:
+    """A figure with its caption and the data it plots."""
+
+    name: str
+    caption: str
+    figure: MplFigure
+    data: pd.DataFrame
+
+
+@dataclass(frozen=True)
+class Legend:
+    """The colours of the verdict classes, with their meanings."""
+
+    marks: tuple[Mark, ...] = field(default_factory=lambda: tuple(legend()))
+
+
+Block = str | Table | Figure | Legend
+
+
+@dataclass
+class Section:
+    """A numbered section: paragraphs (str), tables, figures and legends, in order."""
+
+    anchor: str
+    title: str
+    blocks: list[Block] = field(default_factory=list)
+
+    def figures(self) -> list[Figure]:
+        """The section's figures."""
+        return [b for b in self.blocks if isinstance(b, Figure)]
+
+
+def _inline(text: Any) -> Markup:
+    escaped = str(escape(str(text)))
+    escaped = LINK.sub(r'<a href="\2">\1</a>', escaped)
+    return Markup(CODE.sub(r"<code>\1</code>", escaped).replace("\n", "<br>"))
+
+
+def _css(verdict: Any) -> str:
+    return "v-" + str(verdict).replace(" ", "-")
+
+
+def _blank(value: Any) -> bool:
+    return value is None or (isinstance(value, float) and value != value)
+
+
+class _Html:
+    """Renders blocks with the page's Jinja environment."""
+
+    def __init__(self, rerun: str) -> None:
+        self.rerun = rerun
+        env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined)
+        env.filters.update(inline=_inline, css=_css)
+        self.env = env
+        self.parts = {name: env.from_string(text) for name, text in PARTS.items()}
+
+    def mark(self, m: Mark) -> Markup:
+        return Markup(self.parts["mark"].render(m=m, glyph=GLYPHS[m.verdict]))
+
+    def cell(self, value: Any, command: bool) -> Markup:
+        if isinstance(value, Mark):
+            value = [value]
+        if isinstance(value, list | tuple) and value and all(isinstance(v, Mark) for v in value):
+            return Markup(" ").join(self.mark(m) for m in value)
+        if _blank(value):
+            return Markup("")
+        if command:
+            return Markup('<code class="reproducer">{}</code>').format(value)
+        return _inline(value)
+
+    def render(self, block: Block) -> Markup:
+        if isinstance(block, str):
+            return Markup(self.parts["text"].render(block=block))
+        if isinstance(block, Legend):
+            return Markup(self.parts["legend"].render(block=block, mark=self.mark))
+        caption = _caption(block, self.rerun)
+        if isinstance(block, Figure):
+            return Markup(self.parts["figure"].render(block=block, caption=caption))
+        rows = []
+        for _, row in block.frame.iterrows():
+            cells = [self.cell(v, c in block.commands) for c, v in row.items()]
+            anchor = str(row[block.anchors]) if block.anchors else ""
+            rows.append({"anchor": anchor, "cells": cells})
+        return Markup(self.parts["table"].render(block=block, rows=rows, caption=caption))
+
+    def page(self, title: str, preamble: Sequence[Block], sections: list[Section]) -> str:
+        template = self.env.from_string(TEMPLATE)
+        colours = {str(v): c for v, c in COLOURS.items()}
+        return template.render(
+            title=title,
+            style=Markup(STYLE),
+            colours=colours,
+            preamble=preamble,
+            sections=sections,
+            render=self.render,
+        )
+
+
+def _markdown_cell(value: Any, command: bool) -> str:
+    if isinstance(value, Mark):
+        value = [value]
+    if isinstance(value, list | tuple) and value and all(isinstance(v, Mark) for v in value):
+        return " ".join(m.markdown() for m in value)
+    if _blank(value):
+        return ""
+    text = str(value).replace("|", "\\|").replace("\n", "<br>")
+    return f"`{text}`" if command else text
+
+
+def _markdown(block: Block, rerun: str) -> str:
+    if isinstance(block, str):
+        return block
+    if isinstance(block, Legend):
+        return "Verdicts: " + "; ".join(m.markdown() + f" {m.reason}" for m in block.marks)
+    caption = _caption(block, rerun)
+    if isinstance(block, Figure):
+        return f"![{block.name}]({block.name}.png)\n\n{caption}"
+    frame = block.frame
+    lines = ["| " + " | ".join(map(str, frame.columns)) + " |", "|" + "---|" * len(frame.columns)]
+    for _, row in frame.iterrows():
+        cells = [_markdown_cell(v, c in block.commands) for c, v in row.items()]
+        if block.anchors:
+            cells[0] = f'<a id="{row[block.anchors]}"></a>{cells[0]}'
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + f"\n\n{caption}"
+
+
+def save_figure(figure: MplFigure, name: str, data: pd.DataFrame, out: Path) -> None:
+    """Write ``NAME.png``, ``NAME.svg`` (reproducible: fixed ids, no date) and ``NAME.csv``."""
+    FigureCanvasAgg(figure)
+    # A tight bounding box keeps the legends placed outside the axes.
+    figure.savefig(out / f"{name}.png", dpi=100, bbox_inches="tight")
+    with rc_context({"svg.hashsalt": "lawbench"}):
+        figure.savefig(out / f"{name}.svg", metadata={"Date": None}, bbox_inches="tight")
+    data.to_csv(out / f"{name}.csv", index=False)
+
+
+def save_serially(figures: list[Figure], out: Path) -> None:
+    """Save ``figures`` one after the other in this process."""
+    for block in figures:
+        save_figure(block.figure, block.name, block.data, out)
+
+
+def _caption(block: Table | Figure, rerun: str) -> str:
+    if isinstance(block, Table):
+        return f"{block.caption} Table: [{block.name}.csv]({block.name}.csv)."
+    files = ", ".join(f"[{block.name}.{ext}]({block.name}.{ext})" for ext in ("svg", "csv"))
+    return f"{block.caption} Files: {files}. Rerun: `{rerun}`."
+
+
+def _plain(frame: pd.DataFrame) -> pd.DataFrame:
+    """The frame with marks written as their text, for CSV."""
+
+    def text(value: Any) -> Any:
+        if isinstance(value, Mark):
+            return str(value.verdict)
+        if isinstance(value, list | tuple) and value and all(isinstance(v, Mark) for v in value):
+            return " ".join(m.markdown() for m in value)
+        return value
+
+    return frame.apply(lambda column: column.map(text))
+
+
+def write_page(
+    out: Path,
+    title: str,
+    preamble: Sequence[Block],
+    sections: list[Section],
+    rerun: str,
+    save: Callable[[list[Figure], Path], None] = save_serially,
+) -> None:
+    """Write every file of the report into ``out``: figures, tables, HTML and Markdown.
+
+    ``save`` writes the figures (for example in worker processes).
+    """
+    out.mkdir(parents=True, exist_ok=True)
+    blocks = [*preamble, *(b for s in sections for b in s.blocks)]
+    for block in blocks:
+        if isinstance(block, Table):
+            data = _plain(block.frame) if block.data is None else block.data
+            data.to_csv(out / f"{block.name}.csv", index=False)
+    (out / "index.html").write_text(_Html(rerun).page(title, preamble, sections))
+    markdown = [f"# {title}", *(_markdown(b, rerun) for b in preamble)]
+    markdown += [f"{n}. [{s.title}](#{s.anchor})" for n, s in enumerate(sections, 1)]
+    for section in sections:
+        markdown.append(f'<a id="{section.anchor}"></a>\n\n## {section.title}')
+        markdown += [_markdown(b, rerun) for b in section.blocks]
+    (out / "report.md").write_text("\n\n".join(markdown) + "\n")
+    save([b for b in blocks if isinstance(b, Figure)], out)
+
+
+def number(value: float | None, scale: float = 0.0) -> str:
+    """Four significant digits; rounding noise (below 1e-12 of ``scale``) shown as 0."""
+    if value is None or value != value:
+        return ""
+    return f"{0.0 if abs(value) <= 1e-12 * scale else value:.4g}"

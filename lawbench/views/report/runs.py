@@ -1,0 +1,142 @@
+"""Where the report's studies run, and how its sections read their tables.
+
+Every study a section draws runs once, all of them through one executor
+(`lawbench.studies.runner.run_many`) into ``OUT/runs/NAME.parquet``: the quick mode recomputes them,
+the full mode resumes an interrupted report. A section is a view of study tables: it asks
+`Context.tables` for its view and reads each row's columns (`lawbench.studies.record.Record`).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from lawbench.checks.declared import STUDIES
+from lawbench.checks.study import Study
+from lawbench.core.case import CASES, Case
+from lawbench.core.law import LAWS, Law
+from lawbench.core.registry import Registry
+from lawbench.numerics.transforms import parse
+from lawbench.studies.runner import Executor, run_many
+from lawbench.views.report.config import Config
+
+
+def registered(registry: Registry, wanted: Sequence[str] | None) -> tuple[list[Any], list[str]]:
+    """The entries of ``registry`` (those in ``wanted`` when given) and notes on the others."""
+    notes = []
+    try:
+        names = registry.names()
+    except Exception as exc:  # a module failing to import keeps the ones loaded before it
+        notes.append(f"loading the {registry.kind}s stopped: {type(exc).__name__}: {exc}")
+        names = registry.names()
+    notes += [f"{registry.kind} module `{m}` skipped: {r}" for m, r in registry.unavailable.items()]
+    if wanted is not None:
+        notes += [f"{registry.kind} `{w}` is not registered" for w in wanted if w not in names]
+        names = [name for name in names if name in wanted]
+    return [registry.get(name) for name in names], notes
+
+
+def vector(value: Any) -> np.ndarray | None:
+    """A vector column's value (JSON text) as an array; None for a cell without it."""
+    if not isinstance(value, str) or not value:
+        return None
+    return np.asarray(json.loads(value), dtype=float)
+
+
+def parsed(value: Any) -> Any:
+    """A measure's value: JSON text parsed, a number as it is, None for a missing one."""
+    if isinstance(value, str):
+        return json.loads(value)
+    return None if value is None or value != value else value
+
+
+def axis_value(row: dict[str, Any], axis: str) -> Any:
+    """What a cell shows along ``axis``: a parameter, the transform's value, or a measure.
+
+    A vector parameter is shown by its first entry (the striker's mass of a chain whose other
+    masses are 1 kg).
+    """
+    if axis == "transform":
+        return parse(row["transform"])[1]
+    params = json.loads(row["params"])
+    if axis in params:
+        value = params[axis]
+        return value[0] if isinstance(value, list) else value
+    return parsed(row.get(axis))
+
+
+def label(params: dict[str, Any], skip: Sequence[str]) -> str:
+    """``name=value`` of the parameters a row fixes, those in ``skip`` left out."""
+    shown = []
+    for name, value in params.items():
+        if name in skip:
+            continue
+        if isinstance(value, list):
+            value = value[0] if len(value) == 1 else ",".join(f"{v:g}" for v in value)
+        shown.append(f"{name}={value:g}" if isinstance(value, float) else f"{name}={value}")
+    return ", ".join(shown)
+
+
+class Context:
+    """What the sections share: the configuration, the output folder, the study tables."""
+
+    def __init__(self, config: Config, out: Path) -> None:
+        self.config, self.out = config, out
+        self.laws, law_notes = registered(LAWS, config.laws)
+        self.cases, case_notes = registered(CASES, config.cases)
+        self.notes = law_notes + case_notes
+        self.studies: list[Study] = []
+        self._tables: dict[str, pd.DataFrame] = {}
+
+    @property
+    def rerun(self) -> str:
+        """The command that writes this report again."""
+        return self.config.rerun(str(self.out))
+
+    def case(self, name: str) -> Case:
+        """The scene called ``name``."""
+        return CASES.get(name)
+
+    def law(self, name: str) -> Law:
+        """The law called ``name``."""
+        return LAWS.get(name)
+
+    def run(self, views: Sequence[str]) -> None:
+        """Run every study the ``views`` draw, all through one executor."""
+        config, full = self.config, self.config.mode == "full"
+        laws = [law.name for law in self.laws]
+        cases = [case.name for case in self.cases]
+        plans = []
+        for study in STUDIES.values():
+            if study.view not in views or (study.slow and not full):
+                continue
+            if config.studies is not None and study.name not in config.studies:
+                continue
+            study = study.preset(config.mode)
+            plan = study.plan(laws, cases)
+            if plan.jobs:
+                self.studies.append(study)
+                plans.append((plan, self.out / "runs" / f"{study.name}.parquet"))
+        if not full:
+            shutil.rmtree(self.out / "runs", ignore_errors=True)
+        executor = Executor(
+            config.executor, config.workers, config.budget_s, config.address, chunk_size=10
+        )
+        with executor:
+            results = run_many(plans, executor, resume=True)
+        for study, (table, _) in zip(self.studies, results, strict=True):
+            self._tables[study.name] = table
+
+    def tables(self, view: str) -> list[tuple[Study, pd.DataFrame]]:
+        """The studies of ``view`` that ran, with their tables."""
+        return [(s, self._tables[s.name]) for s in self.studies if s.view == view]
+
+    def every_table(self) -> list[tuple[Study, pd.DataFrame]]:
+        """Every study that ran, with its table."""
+        return [(s, self._tables[s.name]) for s in self.studies]

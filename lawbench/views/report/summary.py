@@ -1,0 +1,163 @@
+"""Section 1, the summary matrix: laws x scenes, the verdict of every check at the defaults.
+
+A view of the ``summary`` study: every law on every scene at its default parameters, with every
+check (continuity and dispersion included). Each cell holds one mark per check, its symbol from
+the key and its colour from the verdict class; a *law property* links to the finding that
+predicts it. A law that refuses the scene gets one *refused* mark, like a check that does not
+apply.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pandas as pd
+
+from lawbench.core.verdicts import Verdict
+from lawbench.studies.record import budget_text
+from lawbench.views.report.marks import Mark
+from lawbench.views.report.page import Legend, Section, Table
+from lawbench.views.report.runs import Context
+
+ANCHOR, TITLE, VIEWS = "summary", "Summary matrix", ("summary",)
+
+
+def abbreviations(names: list[str]) -> dict[str, str]:
+    """One short symbol per check name.
+
+    The initials of its words (``energy_kept``: ``ek``), or, where two names share them, the
+    shortest distinct prefix.
+    """
+    initials = {name: "".join(word[0] for word in name.split("_")) for name in names}
+    short = {}
+    for name in names:
+        if list(initials.values()).count(initials[name]) == 1:
+            short[name] = initials[name]
+            continue
+        length = 1
+        while any(o != name and o.startswith(name[:length]) for o in names) and length < len(name):
+            length += 1
+        short[name] = name[:length]
+    return short
+
+
+def findings(ctx: Context) -> list[dict[str, Any]]:
+    """Every finding of the selected laws, numbered, with its anchor."""
+    rows = []
+    for law in ctx.laws:
+        for index, claim in enumerate(law.findings):
+            number = len(rows) + 1
+            rows.append(
+                {
+                    "finding": number,
+                    "anchor": f"finding-{number}",
+                    "law": law.name,
+                    "index": index,
+                    "check": claim.check,
+                    "where": claim.region.text,
+                    "source": claim.source,
+                    "reason": claim.reason,
+                }
+            )
+    return rows
+
+
+def failure(row: dict[str, Any]) -> str:
+    """``Class: message`` of a cell without an answer, with the budget that ran out."""
+    budget = budget_text(row)
+    return f"{row['error_class']}: {row['error_message']}" + (f" ({budget})" if budget else "")
+
+
+def _marks(row: dict[str, Any], checks: list[str], short: dict, by_key: dict) -> list[Mark]:
+    if row["error_class"]:
+        return [Mark("", Verdict(row["verdict"]), failure(row))]
+    marks = []
+    for check in checks:
+        verdict = Verdict(row[f"{check}_verdict"])
+        reason = f"{check}: {row[f'{check}_detail']}"
+        found = by_key.get((row["law"], row[f"{check}_finding"]))
+        link = f"#{found['anchor']}" if verdict == Verdict.LAW_PROPERTY and found else ""
+        marks.append(Mark(short[check], verdict, reason, link))
+    return marks
+
+
+def build(ctx: Context) -> Section:
+    """The section, from the ``summary`` study's table."""
+    tables = ctx.tables("summary")
+    if not tables:
+        return Section(ANCHOR, TITLE, ["No summary study ran."])
+    study, table = tables[0]
+    checks = list(study.check_names())
+    short = abbreviations(checks)
+    listed = findings(ctx)
+    by_key = {(f["law"], f["index"]): f for f in listed}
+    rows = {(r["law"], r["case"]): r for r in table.fillna({"error_class": ""}).to_dict("records")}
+    matrix: dict[str, dict[str, Any]] = {}
+    tidy, observed = [], {}
+    for law in ctx.laws:
+        matrix[law.name] = {"law": law.name}
+        for case in ctx.cases:
+            row = rows.get((law.name, case.name))
+            if row is None:
+                continue
+            matrix[law.name][case.name] = _marks(row, checks, short, by_key)
+            entry = {"law": law.name, "case": case.name, "verdict": row["verdict"]}
+            if row["error_class"]:
+                tidy.append({**entry, "status": "error", "error": failure(row)})
+                continue
+            verdicts = {c: row[f"{c}_verdict"] for c in checks}
+            values = {f"{c}_value": row[f"{c}_value"] for c in checks}
+            tidy.append({**entry, "status": "ran", **verdicts, **values, "error": ""})
+            for check in checks:
+                found = by_key.get((law.name, row[f"{check}_finding"]))
+                if verdicts[check] == Verdict.LAW_PROPERTY and found:
+                    observed.setdefault(found["finding"], []).append(case.name)
+    frame = pd.DataFrame(list(matrix.values()))
+    columns = ["law", "case", "status", "verdict", *checks, *(f"{c}_value" for c in checks)]
+    data = pd.DataFrame(tidy).reindex(columns=[*columns, "error"])
+    ran = data[data["status"] == "ran"]
+    counts = {v: int((ran[checks] == str(v)).sum().sum()) for v in Verdict}
+    refused = int((data["verdict"] == str(Verdict.REFUSED)).sum())
+    key = ", ".join(f"{s} = {c}" for c, s in short.items())
+    sizes = ", ".join(f"{s:g}" for s in study.settings.get("continuity_sizes", ()))
+    caption = (
+        "Every law on every scene at the scene's default parameters, one mark per check; the "
+        f"key: {key}; continuity perturbed at sizes {sizes}. A mark's colour is its verdict "
+        "(legend above); hover for the reason; a law property links to its finding. A single "
+        "mark is a law that gave no answer: refused (NotApplicable), a budget, or an error."
+    )
+    summary = (
+        f"{len(data)} law-scene cells: {len(ran)} solved, {refused} refused by the law. "
+        "Check verdicts of the solved cells: "
+        + ", ".join(f"{n} {v}" for v, n in counts.items())
+        + "."
+    )
+    columns = ["finding", "law", "check", "where", "in this run", "reason", "source"]
+    list_rows = [
+        {**f, "finding": f["anchor"], "in this run": _observed(f, observed)} for f in listed
+    ]
+    return Section(
+        ANCHOR,
+        TITLE,
+        [
+            summary,
+            Legend(),
+            Table("comparison", caption, frame, data),
+            "Findings: what each law's theory predicts to fail, with the region where it "
+            "applies and its source (the test suite holds every finding at its witnesses).",
+            Table(
+                "findings",
+                "The findings of every law, with the reason; 'in this run' says where the "
+                "matrix met it.",
+                pd.DataFrame(list_rows, columns=columns),
+                anchors="finding",
+            ),
+        ],
+    )
+
+
+def _observed(finding: dict[str, Any], observed: dict[int, list[str]]) -> str:
+    scenes = observed.get(finding["finding"])
+    if not scenes:
+        return "not met in the matrix (its witnesses are other examples)"
+    return "met on " + ", ".join(scenes)

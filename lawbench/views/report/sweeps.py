@@ -1,0 +1,111 @@
+"""Section 8, sweeps of the sources' systems: what each law gives as one parameter varies.
+
+A view of the studies declared with ``view="sweep"``: the study's first axis (a grid parameter)
+is the abscissa, and each of the measures its other axes name (every measure when it names
+none) is drawn against it, one line per law, one panel per
+measure (a vector measure gives one panel per component); the table lists every cell with its
+verdict. An abscissa over two decades or more (a stiffness ratio) is drawn on a log scale.
+The abscissa takes the unit of the scene's parameter, each panel the unit the study
+declares for its measure (``Study.units``): one panel holds one quantity, so quantities of
+different units (m/s, rad/s) never share an axis.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from lawbench.views.report import plots
+from lawbench.views.report.page import Figure, Section, Table, number
+from lawbench.views.report.plots import unit_label
+from lawbench.views.report.runs import Context, axis_value, parsed
+
+ANCHOR, TITLE, VIEWS = "sweeps", "Sweeps of the sources' systems", ("sweep",)
+PANELS_PER_ROW = 3
+
+
+def build(ctx: Context) -> Section:
+    """The section, from every sweep study that ran."""
+    blocks: list[Any] = [
+        "Each system of the sources swept along one parameter: every law that treats it, one "
+        "line per law, each measure on its own panel (the units are in the study's title)."
+    ]
+    for study, table in ctx.tables("sweep"):
+        frame = _tidy(table, study.axes[0], list(study.axes[1:]) or list(study.measures))
+        if frame.empty:
+            blocks.append(f"Study `{study.name}`: no law answered.")
+            continue
+        units = _units(ctx, study.case_names()[0], study.axes[0], study.units)
+        blocks.append(_figure(study.name, study.title, frame, study.axes[0], units))
+        shown = frame.copy()
+        for column in shown.columns.drop(["law", "verdict"]):
+            shown[column] = shown[column].map(number)
+        blocks.append(Table(f"sweep_{study.name}", study.title, shown, data=frame))
+    return Section(ANCHOR, TITLE, blocks)
+
+
+def _tidy(table: pd.DataFrame, axis: str, measures: list[str]) -> pd.DataFrame:
+    """One row per answered cell: law, the axis, each numeric measure (vectors expanded)."""
+    rows = []
+    for row in table.fillna({"error_class": ""}).to_dict("records"):
+        if row["error_class"]:
+            continue
+        tidy: dict[str, Any] = {"law": row["law"], axis: axis_value(row, axis)}
+        for name in measures:
+            value = parsed(row.get(name))
+            if isinstance(value, list):
+                tidy |= {f"{name}[{k}]": v for k, v in enumerate(value) if _number(v)}
+            elif _number(value):
+                tidy[name] = value
+        tidy["verdict"] = row["verdict"]
+        rows.append(tidy)
+    return pd.DataFrame(rows)
+
+
+def _units(ctx: Context, case: str, axis: str, declared: Mapping[str, str]) -> dict[str, str]:
+    """Unit per column: the axis's from its scene's parameter, the measures' as declared."""
+    specs = {spec.name: spec for spec in ctx.case(case).params}
+    units = dict(declared)
+    if axis in specs:
+        units[axis] = specs[axis].unit
+    return units
+
+
+def _decades(values: pd.Series) -> float:
+    """Decades a positive abscissa spans (0 when it reaches zero or below): a log axis from 2."""
+    low, high = float(values.min()), float(values.max())
+    return float(np.log10(high / low)) if low > 0 else 0.0
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _figure(
+    name: str,
+    title: str,
+    frame: pd.DataFrame,
+    axis: str,
+    units: Mapping[str, str] | None = None,
+) -> Figure:
+    columns = [c for c in frame.columns if c not in ("law", axis, "verdict")]
+    rows = -(-len(columns) // PANELS_PER_ROW)
+    fig, axes = plots.figure(rows, min(len(columns), PANELS_PER_ROW))
+    units = units or {}
+    for ax, column in zip(axes.flat, columns, strict=False):
+        for law, group in frame.groupby("law", sort=True):
+            ordered = group.sort_values(axis)
+            ax.plot(ordered[axis], ordered[column], **plots.law_style(str(law)))
+        if _decades(frame[axis]) >= 2:
+            ax.set_xscale("log")
+        ax.set_xlabel(unit_label(axis, units))
+        ax.set_ylabel(unit_label(column, units))
+        ax.set_title(column)
+        ax.legend(fontsize="small")
+    for ax in list(axes.flat)[len(columns) :]:
+        ax.set_visible(False)
+    data = frame.replace({np.nan: None})
+    return Figure(f"sweep_{name}", title, fig, data)
