@@ -35,7 +35,7 @@ import numpy as np
 
 from lawbench.checks.declared import STUDIES, large_friction
 from lawbench.core.case import CASES, Case, GroundTruth, Params, Reference, exactly
-from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.core.problem import MINDLIN_RATIO, Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.numerics.rigid import spatial_column
@@ -49,7 +49,6 @@ TANGENTIAL_COMPLIANCE = GroundTruth(
     options={"tol": 1e-12},
 )
 COORDINATES = ["vx [m/s]", "vy [m/s]", "vz [m/s]", "wx [rad/s]", "wy [rad/s]", "wz [rad/s]"]
-MINDLIN_RATIO = (2 - 0.3) / (2 * (1 - 0.3))
 
 
 def body_on_table(

@@ -23,6 +23,10 @@ from lawbench.core.errors import InvalidProblem
 # The kinds of restitution coefficient and the contact field that overrides ``e`` for each:
 # Newton's kinematic, Poisson's kinetic, Stronge's energetic coefficient.
 RESTITUTION_FIELDS = {"kinematic": "e_newton", "kinetic": "e_poisson", "energetic": "e_energy"}
+# Mindlin's ratio of the normal to the tangential stiffness of a contact between identical
+# elastic bodies of Poisson's ratio 0.3, (2 - nu) / (2 (1 - nu)) = 17/14: the contacts'
+# tangential_stiffness_ratio when none is given (Jia 2013 rounds it to 1.2).
+MINDLIN_RATIO = (2 - 0.3) / (2 * (1 - 0.3))
 # Up to this many coordinates the inverse of M is kept: a product is cheaper than a solve.
 SMALL = 64
 # A matrix with at most this share of non-zero entries is multiplied as a sparse one.
@@ -146,7 +150,8 @@ class Contact:
     damping : float
         Damping coefficient of compliant models.
     tangential_stiffness_ratio : float or None
-        Jia's ratio eta0^2 = k0 / k' of the normal (compression) to the tangential stiffness.
+        Jia's ratio eta0^2 = k0 / k' of the normal (compression) to the tangential stiffness;
+        None for Mindlin's (`MINDLIN_RATIO`).
     """
 
     e: float = 1.0
@@ -159,6 +164,12 @@ class Contact:
     exponent: float = 1.5
     damping: float = 0.0
     tangential_stiffness_ratio: float | None = None
+
+    @property
+    def tangential_ratio(self) -> float:
+        """``tangential_stiffness_ratio``, or Mindlin's when it is None."""
+        ratio = self.tangential_stiffness_ratio
+        return MINDLIN_RATIO if ratio is None else ratio
 
     def validate(self, label: str) -> None:
         """Raise `InvalidProblem` naming ``label.field`` for the first bad field.

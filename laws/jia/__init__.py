@@ -79,8 +79,6 @@ from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
 from lawbench.numerics.solvers import solve_lcp
 
-POISSON_RATIO = 0.3
-DEFAULT_TANGENTIAL_STIFFNESS_RATIO = (2 - POISSON_RATIO) / (2 * (1 - POISSON_RATIO))
 APPROACH = 1e-12
 
 
@@ -174,9 +172,7 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
     """Integrate Jia's springs; ``d`` tangential directions at the single contact (0: none)."""
     m = problem.m
     contact = problem.contacts[0]
-    eta0_sq = contact.tangential_stiffness_ratio
-    if eta0_sq is None:
-        eta0_sq = DEFAULT_TANGENTIAL_STIFFNESS_RATIO
+    eta0_sq = contact.tangential_ratio
     stiffness = np.array([c.stiffness for c in problem.contacts])
     springs = Springs(stiffness / stiffness[0], e, contact.mu if d else 0.0, eta0_sq)
     if d:
