@@ -252,7 +252,8 @@ def test_the_engine_names_no_law_or_scene():
 
 def test_a_sweep_draws_each_measure_against_its_axis_per_law():
     """The billiard sweep: one row per answered cell with the elevation and every numeric
-    measure (the spin vector expanded), one panel per measure, one line per law."""
+    measure (the spin vector expanded), one panel per measure, one line per law (those that
+    treat two spatial frictional contacts)."""
     from lawbench.studies.runner import Executor, collect
     from lawbench.views.report import sweeps
 
@@ -260,8 +261,9 @@ def test_a_sweep_draws_each_measure_against_its_axis_per_law():
     with Executor() as pool:
         table = collect(study.plan(), pool)
     frame = sweeps._tidy(table, "elevation", list(study.measures))
-    assert set(frame["law"]) == {"moreau"}
-    assert sorted(frame["elevation"]) == [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]
+    assert set(frame["law"]) == {"moreau", "compliant"}
+    for _, rows in frame.groupby("law"):
+        assert sorted(rows["elevation"]) == [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]
     assert {"ball_speed", "spin[0]", "spin[2]", "spin_tilt"} <= set(frame.columns)
     units = {**study.units, "elevation": "deg"}
     figure = sweeps._figure("billiard", study.title, frame, "elevation", units)

@@ -1,49 +1,8 @@
-"""Compliant contacts: the impact resolved in time, each contact a unilateral force law.
+"""Compliant contacts without friction: unilateral force laws integrated in contact space.
 
-Source: Brogliato, *An introduction to impact dynamics* (2010), compliant contacts: the
-Kelvin-Voigt spring-dashpot ``F = k d + c d'`` and its two terminations with their restitution
-coefficients; Hertz's law ``F = K d^n`` (n = 3/2) and Hertzian (Kuwabara-Kono) damping
-``c d^(n-1) d'``; Hunt and Crossley's law ``F = K d^n (1 + c d')`` (J. Appl. Mech. 42, 1975),
-with ``c`` from the restitution coefficient and the approach speed ``v0`` by a named rule:
-Hunt and Crossley 1975, ``c = 3 (1 - e) / (2 v0)``; Lankarani and Nikravesh (J. Mech. Des.
-112, 1990), ``c = 3 (1 - e^2) / (4 v0)``; Flores, Machado, Silva and Martins (Multibody Syst.
-Dyn. 25, 2011), ``c = 8 (1 - e) / (5 e v0)``.
-
-Conventions: the indentation of contact j is ``d_j = -g_j`` (g the gap, zero at first
-contact), its rate ``d'_j = -un_j``; the contact force pushes apart and gives the impulse
-``Pn_j``; ``M v' = Wn F``, gravity and every other force ignored during the impact. A contact
-acts while ``d_j > 0``. With ``termination='gap'`` (Kelvin-Voigt only) its force is the law's
-value even when the dashpot makes it attractive at the end; otherwise the force is
-``max(0, law)``, so a contact releases when its force returns to zero.
-
-Damping: a contact's ``damping`` is the coefficient of the model's dashpot when positive (N s/m
-for Kelvin-Voigt, N s / m^n for Hertzian damping, s/m for Hunt-Crossley); at zero it comes
-from the contact's ``e``: Kelvin-Voigt inverts the lectures' closed form of the chosen
-termination with the contact's effective mass ``1 / G_jj``; Hunt-Crossley applies its rule
-with ``v0`` the largest pre-impact approach speed of the scene, for every contact and the whole
-impact (a contact that a wave closes later has no approach speed of its own: taking its speed
-at closure, which can be near zero, makes the damping unbounded); Hertz is elastic and refuses
-``e < 1``.
-
-Numerics: scipy's ``solve_ivp`` (DOP853 by default) in contact space, ``g' = un``,
-``un' = G F``, ``Pn' = F`` with ``G = Wn.T M^-1 Wn`` the Delassus matrix, in scaled variables
-(velocities over the largest approach speed V, lengths over the largest static indentation
-scale, time over their ratio); the velocity follows once from the impulses. It is restarted at
-every event where a force law changes branch (a contact closes, opens, or its force crosses
-zero), so the right-hand side is smooth between restarts. Between restarts only the closed
-contacts and the contacts their columns of G reach are integrated; every other gap moves
-linearly and the first of them to close is met in closed form, so a wave along an n-ball chain
-costs O(n) and not O(n^2). The integrator resolves no speed below ``tol`` V: a contact that
-approaches more slowly is at rest (the noise of the integration leaves the balls behind a
-Hertz wave with speeds of that order, whose collisions would otherwise multiply the events as
-n^2), and a contact acts once its spring holds the kinetic energy of its effective mass at that
-speed. The impact ends when no spring is compressed and no contact approaches faster than
-``tol`` V. The accuracy knob is ``tol`` (atol = tol times 1e-3 in scaled units). Order of
-convergence: the error of ``v_plus`` against a tight-tolerance reference falls in proportion
-to tol (slope 1 in log-log; on the three-ball chain it stays between 0.01 and 0.2 times tol
-from 1e-3 to 1e-10, tested), while DOP853's step count grows only as about tol^(-1/8).
-Budgets: ``max_steps`` solver steps and ``max_events`` restarts and ``max_seconds`` of
-wall-clock time, each raising `SolverFailure` naming what ran out.
+The normal force laws, their damping from a restitution coefficient, and the integration of
+the gaps, gap rates and impulses of every contact (`lawbench.laws.compliant` states the
+model, its conventions and its numerics).
 """
 
 from __future__ import annotations
@@ -55,16 +14,12 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
-from lawbench.laws._claims import keeps_energy, never_creates_energy
 
 from lawbench.core import budget
 from lawbench.core.errors import NotApplicable
-from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import for_products
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
-from lawbench.core.spec import Spec
-from lawbench.core.tags import Tags
 from lawbench.numerics.integrator import EventIntegrator
 
 MODELS = ("kelvin_voigt", "hertz", "hunt_crossley")
@@ -109,67 +64,7 @@ def _kelvin_voigt_ratio(e: float, termination: str) -> float:
     )
 
 
-class Compliant(Law):
-    """Time integration of unilateral compliant contacts (Kelvin-Voigt, Hertz, Hunt-Crossley)."""
-
-    name = "compliant"
-    summary = (
-        "time integration of unilateral compliant contacts (Kelvin-Voigt, Hertz, Hunt-Crossley)"
-    )
-    source = "Brogliato 2010, compliant contacts; Hunt and Crossley 1975; Flores et al. 2011"
-    tags = Tags(several_contacts=True, stiffness=True, accuracy_knob="tol")
-    separating_rule = (
-        "a separating contact carries a force only while its spring is compressed, if the "
-        "motion closes it again"
-    )
-    follows_gaps = True
-    guarantees = (
-        keeps_energy(
-            "Brogliato 2010, compliant contacts; Hunt and Crossley 1975",
-            "at e = 1 every force law is a spring without damping, a conservative system",
-        ),
-        never_creates_energy(
-            "Brogliato 2010, compliant contacts; Hunt and Crossley 1975",
-            "springs with non-negative damping only give back what they stored",
-        ),
-    )
-    options = (
-        Spec("model", "hunt_crossley", "force law of every contact", kind="str", choices=MODELS),
-        Spec("tol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),
-        Spec(
-            "termination",
-            "force",
-            "Kelvin-Voigt: contact ends when the gap reopens or when its force returns to zero",
-            kind="str",
-            choices=("gap", "force"),
-        ),
-        Spec(
-            "damping_rule",
-            "flores",
-            "Hunt-Crossley: rule giving the damping from e and the approach speed",
-            kind="str",
-            choices=tuple(DAMPING_RULES),
-        ),
-        Spec(
-            "method",
-            "DOP853",
-            "solve_ivp method",
-            kind="str",
-            choices=("DOP853", "RK45", "Radau", "LSODA"),
-        ),
-        Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
-        Spec("max_events", 100_000, "budget of restarts at contact events", "", "int", 1),
-        Spec("path", False, "return time histories of forces and stored energies", "", "bool"),
-    )
-
-    def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
-        return _Integration(problem, options).run()
-
-
-LAWS.register(Compliant())
-
-
-class _Integration:
+class Integration:
     """One compliant impact in contact space: scaled gaps, gap rates and impulses.
 
     With ``G = Wn.T M^-1 Wn`` the Delassus matrix, the m contacts obey ``g' = un``,
@@ -197,12 +92,19 @@ class _Integration:
         G = scipy.sparse.csc_array(problem.delassus)
         diagonal = G.diagonal()
         self.V = float(max(np.abs(problem.un).max(), 1e-300))
-        indentation = ((self.n + 1) * self.V**2 / (2 * self.k * diagonal)) ** (1 / (self.n + 1))
-        self.L = float(indentation.min())
+        # Each contact's indentation scale: where its spring holds the kinetic energy of its
+        # effective mass 1 / G_jj at the largest approach speed.
+        self.indentation = ((self.n + 1) * self.V**2 / (2 * self.k * diagonal)) ** (
+            1 / (self.n + 1)
+        )
+        self.L = float(self.indentation.min())
         self.tau = self.L / self.V
-        self.I = self.V / float(diagonal.max())
+        self.G_max = float(diagonal.max())
+        self.I = self.V / self.G_max
+        # A force in newtons as a scaled impulse rate (time over tau, impulses over I).
+        self.scale = self.tau / self.I
         # Scaled Delassus matrix: the scaled gap-rate change per scaled impulse.
-        self.G = G / float(diagonal.max())
+        self.G = G / self.G_max
         self.clipped = not (self.model == "kelvin_voigt" and options["termination"] == "gap")
         self.c = self._initial_damping(diagonal)
         # The integrator resolves no speed below ``tol`` V (scaled: ``tol``): a contact that
@@ -234,23 +136,56 @@ class _Integration:
                 c[j] = rule(self.e[j], self.V)
         return c
 
-    def forces(self, g: np.ndarray, un: np.ndarray, j: np.ndarray) -> np.ndarray:
-        """Forces in newtons of the closed contacts ``j``, from their scaled gaps and rates.
+    def law(self, g: np.ndarray, un: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """The force laws of the closed contacts ``j`` (N), before clipping at zero.
 
-        ``g`` and ``un`` hold one contact per entry of their last axis.
+        ``g`` and ``un`` are scaled gaps and rates, one contact per entry of their last axis.
         """
         d, rate = -self.L * g, -self.V * un
         k, n, c = self.k[j], self.n[j], self.c[j]
         if self.model == "kelvin_voigt":
-            law = k * d + c * rate
-        else:
-            # Zero where the contact is open (0^n = 0): the powers need no mask.
-            dn = np.maximum(d, 0.0) ** n
-            if self.model == "hertz":
-                law = k * dn + c * np.maximum(d, 0.0) ** (n - 1) * rate
-            else:
-                law = k * dn * (1.0 + c * rate)
+            return k * d + c * rate
+        # Zero where the contact is open (0^n = 0): the powers need no mask.
+        dn = np.maximum(d, 0.0) ** n
+        if self.model == "hertz":
+            return k * dn + c * np.maximum(d, 0.0) ** (n - 1) * rate
+        return k * dn * (1.0 + c * rate)
+
+    def forces(self, g: np.ndarray, un: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Forces in newtons of the closed contacts ``j``, from their scaled gaps and rates."""
+        law = self.law(g, un, j)
         return np.maximum(law, 0.0) if self.clipped else law
+
+    def force_rate(
+        self, g: np.ndarray, un: np.ndarray, un_rate: np.ndarray, j: np.ndarray
+    ) -> np.ndarray:
+        """The rate of the force laws of the closed contacts ``j`` in scaled time (N).
+
+        ``un_rate`` is the scaled rate of the gap rates; the indentation changes at
+        ``-L un`` and its rate at ``-V un_rate`` per unit of scaled time.
+        """
+        d, rate = np.maximum(-self.L * g, 0.0), -self.V * un
+        k, n, c = self.k[j], self.n[j], self.c[j]
+        if self.model == "kelvin_voigt":
+            by_d, by_rate = k, c
+        elif self.model == "hertz":
+            with np.errstate(divide="ignore", invalid="ignore"):
+                damped = np.where(c > 0, (n - 1) * c * d ** (n - 2) * rate, 0.0)
+            by_d, by_rate = n * k * d ** (n - 1) + damped, c * d ** (n - 1)
+        else:
+            by_d, by_rate = n * k * d ** (n - 1) * (1.0 + c * rate), k * d**n * c
+        return by_d * (-self.L * un) + by_rate * (-self.V * un_rate)
+
+    def law_sign(self, g: np.ndarray, un: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """A function of the closed contacts ``j`` with the sign of their force laws.
+
+        The factor that decides it, ``1 + c d'`` (Hunt-Crossley) or ``k d + c d'``, rather than
+        a law that vanishes with the indentation.
+        """
+        rate = -self.V * un
+        if self.model == "hunt_crossley":
+            return 1.0 + self.c[j] * rate
+        return self.k[j] * (-self.L * g) + self.c[j] * rate
 
     def stored(self, g: np.ndarray) -> np.ndarray:
         """Elastic energy of every contact's spring at the scaled gaps ``g``."""
@@ -262,6 +197,7 @@ class _Integration:
         return bool((g > -self.band).all()) and bool((un >= -self.rest).all())
 
     def run(self) -> Outcome:
+        """Integrate from first contact until no spring acts and no contact approaches."""
         problem, options = self.problem, self.options
         m = problem.m
         g, un, P = problem.gaps / self.L, problem.un / self.V, np.zeros(m)
@@ -355,13 +291,13 @@ class _Mode:
     and those their forces reach.
     """
 
-    def __init__(self, integration: _Integration, closed: np.ndarray, near: np.ndarray) -> None:
+    def __init__(self, integration: Integration, closed: np.ndarray, near: np.ndarray) -> None:
         self.integration, self.closed, self.near = integration, np.flatnonzero(closed), near
         rows = np.flatnonzero(near)
         self.size = rows.size
         self.acting = np.searchsorted(rows, self.closed)
         # Scaled: the time is over tau, so the scaled force is the impulse rate over I / tau.
-        self.scale = integration.tau / integration.I
+        self.scale = integration.scale
         self.G = for_products(integration.G[rows][:, self.closed].toarray())
         self.band = integration.band[rows]
         self.damped = integration.clipped and bool(integration.c[self.closed].any())
@@ -387,10 +323,6 @@ class _Mode:
         gaps = g + self.band
         if not self.damped:
             return gaps
-        c, closed = self.integration.c[self.closed], self.closed
-        rate = -self.integration.V * un[self.acting]
-        if self.integration.model == "hunt_crossley":
-            sign = 1.0 + c * rate
-        else:
-            sign = self.integration.k[closed] * (-self.integration.L * g[self.acting]) + c * rate
+        c = self.integration.c[self.closed]
+        sign = self.integration.law_sign(g[self.acting], un[self.acting], self.closed)
         return np.concatenate([gaps, np.where(c > 0, sign, 1.0)])
