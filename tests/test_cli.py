@@ -463,3 +463,17 @@ def test_a_solve_of_built_in_entries_reads_no_metadata_and_no_batch_code(module)
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "False"
+
+
+def test_describe_names_every_scenes_ground_truth():
+    """A scene's outcomes are measured against its declared ground truth: describe prints it,
+    with why, on a line of its own."""
+    commands = [[sys.executable, "-m", "lawbench", "describe", name] for name in CASES]
+    for name, done in zip(CASES, run_together(*commands), strict=True):
+        assert done.returncode == 0, done.stderr
+        (line,) = [line for line in done.stdout.splitlines() if line.startswith("ground truth:")]
+        truth = lawbench.CASES[name].ground_truth
+        expected = (
+            f"ground truth: {truth.describe()}: {truth.why}" if truth else "ground truth: none"
+        )
+        assert line == expected

@@ -165,6 +165,8 @@ def _describe_case(case: Case) -> None:
     for spec in case.params:
         unit = f" [{spec.unit}]" if spec.unit else ""
         print(f"  {spec.name} = {spec.default!r}{unit}  ({spec.describe_range()}) {spec.doc}")
+    truth = case.ground_truth
+    print(f"ground truth: {truth.describe()}: {truth.why}" if truth else "ground truth: none")
     print("references:" if case.references else "references: none")
     for ref in case.references:
         options = "".join(f" {k}={v}" for k, v in ref.options.items())
