@@ -121,10 +121,10 @@ class Compliant(Law):
         ),
         Spec(
             "method",
-            "DOP853",
-            "solve_ivp method",
+            "auto",
+            "solve_ivp method; auto: LSODA with spatial friction, DOP853 otherwise",
             kind="str",
-            choices=("DOP853", "RK45", "Radau", "LSODA"),
+            choices=("auto", "DOP853", "RK45", "Radau", "LSODA"),
         ),
         Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
         Spec("max_events", 100_000, "budget of restarts at contact events", "", "int", 1),

@@ -75,11 +75,15 @@ class Integration:
     closed form, and the first of them to close ends the integration there.
     """
 
+    # The method of ``method='auto'``.
+    AUTO = "DOP853"
+
     def __init__(self, problem: ImpactProblem, options: dict[str, Any]) -> None:
         import scipy.sparse
 
         self.problem, self.options = problem, options
         self.model = options["model"]
+        self.method = self.AUTO if options["method"] == "auto" else options["method"]
         contacts = problem.contacts
         self.k = np.array([c.stiffness for c in contacts])
         self.n = (
@@ -202,7 +206,7 @@ class Integration:
         m = problem.m
         g, un, P = problem.gaps / self.L, problem.un / self.V, np.zeros(m)
         rtol = options["tol"]
-        integrator = EventIntegrator(options["method"], rtol, rtol * 1e-3)
+        integrator = EventIntegrator(self.method, rtol, rtol * 1e-3)
         spend = budget.current()
         t, self.steps, events = 0.0, 0, 0
         self.peak = np.zeros(m)
@@ -241,7 +245,7 @@ class Integration:
                 g[first] = -self.band[first]
             events += 1
         diagnostics = {
-            "formulation": f"time integration ({self.model}, {options['method']})",
+            "formulation": f"time integration ({self.model}, {self.method})",
             "duration_s": t * self.tau,
             "peak_force": self.peak.tolist(),
             "damping": self.c.tolist(),
