@@ -297,7 +297,7 @@ def test_a_sweep_over_decades_draws_a_log_abscissa():
     study = STUDIES.get("ping_pong").with_params({}).preset("quick")
     study = dataclasses.replace(study, laws=("sequential",))
     with Executor() as pool:
-        table = collect(study.plan(laws=["moreau"]), pool)
+        table = collect(study.plan(), pool)
     frame = sweeps._tidy(table, "stiffness_ratio", list(study.measures))
     units = {**study.units, "stiffness_ratio": ""}
     figure = sweeps._figure("ping_pong", study.title, frame, "stiffness_ratio", units)
