@@ -8,6 +8,8 @@ from lawbench.core.law import LAWS
 from lawbench.studies.bench import report, start_up_command, subject
 
 
+# A benchmark run end to end (about 13 s): a study of cost, not of correctness.
+@pytest.mark.slow
 def test_the_benchmark_prints_every_figure_with_its_peer():
     text = report(quick=True)
     assert text.startswith("lawbench bench on ")

@@ -42,6 +42,8 @@ def test_noise_free_data_give_the_coefficients_to_1e_8():
     assert result.non_identifiable == []
 
 
+# A statistical study over 200 fits (about 10 s).
+@pytest.mark.slow
 def test_recovery_within_two_standard_errors_in_90_percent_of_200_trials():
     """Coverage of the Jacobian's standard errors: data from Newton's law plus Gaussian noise.
 

@@ -96,6 +96,8 @@ def test_poisson_dissipates_with_separating_contacts(seed):
     assert outcome.dT <= 1e-12 * outcome.T_minus
 
 
+# A sweep over random chains (about 30 s): a study of the law over seeds.
+@pytest.mark.slow
 @pytest.mark.parametrize("approaching", [True, False])
 def test_sequential_impacts_dissipate_or_report_a_collapse(approaching):
     """Every sequence of binary impacts with e < 1 dissipates; with small e some chains need
