@@ -24,7 +24,6 @@ import math
 from typing import Any
 
 from lawbench.cases._chains import SPRINGS
-
 from lawbench.checks.declared import STUDIES, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.problem import ImpactProblem

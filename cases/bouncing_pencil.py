@@ -32,6 +32,7 @@ import math
 from typing import Any
 
 import numpy as np
+
 from lawbench.cases.bouncing_ball import (
     COORDINATES,
     TANGENTIAL_COMPLIANCE,
@@ -41,7 +42,6 @@ from lawbench.cases.bouncing_ball import (
     frictionless_reference,
     vector_spec,
 )
-
 from lawbench.checks.declared import STUDIES, large_friction
 from lawbench.core.case import CASES, Case, Params, exactly
 from lawbench.core.problem import ImpactProblem

@@ -32,8 +32,8 @@ import math
 from typing import Any
 
 import numpy as np
-from lawbench.cases._friction import stronge
 
+from lawbench.cases._friction import stronge
 from lawbench.checks.declared import STUDIES, energy_map, large_friction
 from lawbench.core.case import CASES, Case, Params, exactly
 from lawbench.core.problem import Contact, ImpactProblem

@@ -45,8 +45,8 @@ import math
 from typing import Any
 
 import numpy as np
-from lawbench.cases._friction import stronge
 
+from lawbench.cases._friction import stronge
 from lawbench.checks.declared import (
     STUDIES,
     duplicated_contact,

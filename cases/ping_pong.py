@@ -44,8 +44,8 @@ import dataclasses
 from typing import Any
 
 import numpy as np
-from lawbench.cases.two_balls_wall import TwoBallsWall
 
+from lawbench.cases.two_balls_wall import TwoBallsWall
 from lawbench.checks.declared import STUDIES
 from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Params

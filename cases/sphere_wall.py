@@ -29,8 +29,8 @@ import math
 from typing import Any
 
 import numpy as np
-from lawbench.cases._friction import stronge
 
+from lawbench.cases._friction import stronge
 from lawbench.checks.declared import STUDIES, grazing, large_friction
 from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, Params, Reference, exactly

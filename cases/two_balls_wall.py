@@ -14,8 +14,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.cases._chains import SPRINGS
 
+from lawbench.cases._chains import SPRINGS
 from lawbench.checks.declared import (
     STUDIES,
     continuity,

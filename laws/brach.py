@@ -46,7 +46,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.laws._claims import keeps_energy
 
 from lawbench.checks.regions import coupled_friction
 from lawbench.core.errors import NotApplicable
@@ -55,6 +54,7 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
+from lawbench.laws._claims import keeps_energy
 
 # Below this fraction of |un-| a slip velocity counts as zero.
 NO_SLIP = 1e-12

@@ -81,12 +81,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from lawbench.laws._claims import (
-    PAOLI_DISCONTINUITY,
-    RIGID_DISPERSION,
-    keeps_energy,
-    separating_held,
-)
 
 from lawbench.checks.regions import coupled_friction, option, separating_contact
 from lawbench.core import budget
@@ -97,6 +91,12 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
+from lawbench.laws._claims import (
+    PAOLI_DISCONTINUITY,
+    RIGID_DISPERSION,
+    keeps_energy,
+    separating_held,
+)
 from lawbench.numerics import cones
 from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
 

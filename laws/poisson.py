@@ -23,7 +23,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from lawbench.laws._claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 
 from lawbench.checks.regions import separating_contact
 from lawbench.core.law import LAWS, Law
@@ -31,6 +30,7 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
+from lawbench.laws._claims import PAOLI_DISCONTINUITY, RIGID_DISPERSION, keeps_energy
 from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, solve_lcp
 
 if TYPE_CHECKING:

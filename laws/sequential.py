@@ -25,7 +25,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.laws._claims import RIGID_DISPERSION, keeps_energy, never_creates_energy
 
 from lawbench.core import budget
 from lawbench.core.law import LAWS, Law
@@ -33,6 +32,7 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
+from lawbench.laws._claims import RIGID_DISPERSION, keeps_energy, never_creates_energy
 
 APPROACH_TOLERANCE = 1e-12
 RECORDED = 10_000

@@ -76,12 +76,6 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
-from lawbench.laws._claims import (
-    PAOLI_DISCONTINUITY,
-    RIGID_DISPERSION,
-    keeps_energy,
-    separating_held,
-)
 
 from lawbench.checks.regions import coupled_friction
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
@@ -91,6 +85,12 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
+from lawbench.laws._claims import (
+    PAOLI_DISCONTINUITY,
+    RIGID_DISPERSION,
+    keeps_energy,
+    separating_held,
+)
 from lawbench.numerics.lemke import RayTermination, lemke
 
 # Largest number of planar contacts whose 4^m mode combinations are enumerated.

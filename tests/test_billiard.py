@@ -4,9 +4,9 @@ import math
 
 import numpy as np
 import pytest
-from lawbench.cases.billiard import cue_geometry
 
 import lawbench
+from lawbench.cases.billiard import cue_geometry
 
 CASE = lawbench.CASES.get("billiard")
 
@@ -84,7 +84,6 @@ def test_english_alone_runs_straight_and_a_masse_shot_curves():
     friction only slows the ball: the path's curvature is zero for a horizontal shot with side
     offset; a masse shot's tilted spin axis bends the path, the mirrored shot the other way."""
     from lawbench.cases.billiard import path_curvature
-
     from lawbench.core.trial import Trial
 
     def curvature(**params):

@@ -4,10 +4,10 @@ import math
 
 import numpy as np
 import pytest
-from lawbench.laws.compliant import DAMPING_RULES, kelvin_voigt_restitution
 
 import lawbench
 from lawbench import Contact, ImpactProblem
+from lawbench.laws.compliant import DAMPING_RULES, kelvin_voigt_restitution
 
 LAW = lawbench.LAWS.get("compliant")
 

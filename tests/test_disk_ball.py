@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from lawbench.cases.disk_ball import disk_inertia, jacobians
 
 import lawbench
+from lawbench.cases.disk_ball import disk_inertia, jacobians
 
 R, H, B = 0.05, 0.005, 0.02
 

@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 import pytest
-from lawbench.cases.falling_rod import impulse_response
-from lawbench.cases.rocking_block import housner_ratio, sticking_ratio
 
 import lawbench
 from lawbench import InvalidProblem
+from lawbench.cases.falling_rod import impulse_response
+from lawbench.cases.rocking_block import housner_ratio, sticking_ratio
 
 CASES = ("rocking_block", "falling_rod", "double_pendulum", "sphere_wall")
 

@@ -9,11 +9,11 @@ import math
 
 import numpy as np
 import pytest
-from lawbench.cases.bouncing_pencil import pencil_geometry
 from scipy.integrate import solve_ivp
 
 import lawbench
 from lawbench import Contact, ImpactProblem
+from lawbench.cases.bouncing_pencil import pencil_geometry
 
 LAW = lawbench.LAWS.get("jia")
 BALL = lawbench.CASES.get("bouncing_ball")

@@ -11,10 +11,10 @@ import itertools
 
 import numpy as np
 import pytest
-from lawbench.laws.whittaker import planar_friction_lcp
 
 from lawbench.core.errors import InvalidProblem, SolverFailure
 from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.laws.whittaker import planar_friction_lcp
 from lawbench.numerics.lemke import RayTermination, lemke
 
 

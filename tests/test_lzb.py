@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 import scipy.linalg
-from lawbench.cases.bead_column import MEASURED_PEAK_FORCE, MEASURED_PERIOD
 
 import lawbench
 from lawbench import Contact, ImpactProblem
+from lawbench.cases.bead_column import MEASURED_PEAK_FORCE, MEASURED_PERIOD
 from lawbench.numerics.rigid import planar_column, planar_tangent
 
 LAW = lawbench.LAWS.get("lzb")
@@ -500,9 +500,8 @@ def test_a_contact_compressed_again_is_the_declared_frozen_configuration_finding
     the law's, and its dispersion verdict names that finding; where no contact is compressed
     again (a soft wall) the same check holds against the compliant ground truth.
     """
-    from lawbench.laws._claims import FROZEN_CONFIGURATION
-
     from lawbench.core.verdicts import Verdict
+    from lawbench.laws._claims import FROZEN_CONFIGURATION
 
     stiff = lawbench.evaluate(law, "two_balls_wall", stiffness_ratio=100.0)
     assert stiff.outcome.diagnostics["recompressed"] == [1]

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from lawbench.cases.rocking_block import housner_ratio
 
 import lawbench
+from lawbench.cases.rocking_block import housner_ratio
 from lawbench.checks.declared import STUDIES
 from lawbench.checks.study import Study
 from lawbench.core.verdicts import Verdict

@@ -15,11 +15,11 @@ import math
 import numpy as np
 import pytest
 import scipy.optimize
-from lawbench.laws.whittaker import MAX_ENUMERATED
 
 import lawbench
 from lawbench.core.errors import NotApplicable, SolverFailure
 from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.laws.whittaker import MAX_ENUMERATED
 from lawbench.numerics.rigid import spatial_column
 
 LAW = lawbench.LAWS.get("whittaker")

@@ -57,6 +57,11 @@ from __future__ import annotations
 
 from typing import Any
 
+from lawbench.core.law import LAWS, Law
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.spec import Spec
+from lawbench.core.tags import Tags
 from lawbench.laws._claims import keeps_energy, never_creates_energy
 from lawbench.laws.compliant.friction import FrictionalIntegration
 from lawbench.laws.compliant.normal import (
@@ -65,12 +70,6 @@ from lawbench.laws.compliant.normal import (
     Integration,
     kelvin_voigt_restitution,
 )
-
-from lawbench.core.law import LAWS, Law
-from lawbench.core.outcome import Outcome
-from lawbench.core.problem import ImpactProblem
-from lawbench.core.spec import Spec
-from lawbench.core.tags import Tags
 
 __all__ = ["DAMPING_RULES", "MODELS", "Compliant", "kelvin_voigt_restitution"]
 

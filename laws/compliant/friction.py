@@ -56,11 +56,11 @@ from functools import partial
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from lawbench.laws.compliant.normal import Integration
 
 from lawbench.core import budget
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
+from lawbench.laws.compliant.normal import Integration
 from lawbench.numerics.integrator import EventIntegrator
 
 if TYPE_CHECKING:

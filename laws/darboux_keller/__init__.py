@@ -59,13 +59,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.laws._claims import keeps_energy, never_creates_energy
-from lawbench.laws.darboux_keller.dynamics import (
-    ImpactRecord,
-    SingleContactImpact,
-    State,
-    path_arrays,
-)
 
 from lawbench.checks.declared import STUDIES, impact_path
 from lawbench.checks.regions import option
@@ -74,6 +67,13 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
+from lawbench.laws._claims import keeps_energy, never_creates_energy
+from lawbench.laws.darboux_keller.dynamics import (
+    ImpactRecord,
+    SingleContactImpact,
+    State,
+    path_arrays,
+)
 
 # Each termination reads the contact's coefficient of its own kind.
 COEFFICIENT = {"newton": "kinematic", "poisson": "kinetic", "energetic": "energetic"}

@@ -58,14 +58,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from lawbench.laws._claims import (
-    ENERGETIC_DISSIPATION,
-    FROZEN_CONFIGURATION,
-    PAOLI_DISCONTINUITY,
-    keeps_energy,
-    never_creates_energy,
-)
-from lawbench.laws.jia.dynamics import SpringImpact, Springs
 
 from lawbench.checks.declared import STUDIES, impact_path
 from lawbench.checks.regions import nonlinear_springs
@@ -77,6 +69,14 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
+from lawbench.laws._claims import (
+    ENERGETIC_DISSIPATION,
+    FROZEN_CONFIGURATION,
+    PAOLI_DISCONTINUITY,
+    keeps_energy,
+    never_creates_energy,
+)
+from lawbench.laws.jia.dynamics import SpringImpact, Springs
 from lawbench.numerics.solvers import solve_lcp
 
 APPROACH = 1e-12

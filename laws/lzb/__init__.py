@@ -114,14 +114,6 @@ from typing import Any
 
 import numpy as np
 import scipy.special
-from lawbench.laws._claims import (
-    ENERGETIC_DISSIPATION,
-    FROZEN_CONFIGURATION,
-    PAOLI_DISCONTINUITY,
-    keeps_energy,
-    never_creates_energy,
-)
-from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 from lawbench.checks.declared import STUDIES, impact_path
 from lawbench.core.law import LAWS, Law
@@ -130,6 +122,14 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
+from lawbench.laws._claims import (
+    ENERGETIC_DISSIPATION,
+    FROZEN_CONFIGURATION,
+    PAOLI_DISCONTINUITY,
+    keeps_energy,
+    never_creates_energy,
+)
+from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 
 class LiuZhaoBrogliato(Law):
