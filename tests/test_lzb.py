@@ -409,6 +409,23 @@ def test_the_ladder_stays_in_its_friction_cones(mu, e):
     assert np.all(ladder(mu).Wn.T @ outcome.v_plus >= -1e-8)
 
 
+@pytest.mark.parametrize("width", [0.5, 1.0, 1.77828, 3.0])
+@pytest.mark.parametrize("mu", [0.3, 1.0])
+def test_the_block_shares_its_friction_between_corners_on_one_floor_line(width, mu):
+    """The rocking block's corners lie on one floor line: their tangential velocities are one
+    (the tangential Delassus block is singular), so while both stick only the sum of their
+    friction forces is decided. Coulomb's law (Zhang et al. 2013) still holds each corner in its
+    own cone, |dPt_j| <= mu dPn_j along the impact, and a corner that enters the impact with no
+    normal force carries no friction.
+    """
+    case = lawbench.CASES.get("rocking_block")
+    outcome = LAW.resolve(case.build(width=width, mu=mu), path=True)
+    assert np.all(np.abs(outcome.Pt) <= mu * outcome.Pn * (1 + 1e-9) + 1e-12)
+    dPn, dPt = np.diff(outcome.path["Pn"], axis=0), np.diff(outcome.path["Pt"], axis=0)
+    assert np.all(np.abs(dPt) <= mu * dPn * (1 + 1e-6) + 1e-9)
+    assert outcome.dT <= 0
+
+
 def test_random_rough_ladders_stay_admissible_and_dissipative():
     """Coulomb's law dissipates and Stronge's coefficient releases at most the compression work
     (Zhang et al. 2013): random coefficients, angles and velocities of the ladder, both

@@ -78,7 +78,7 @@ class Segment:
     (0 when idle); ``s_floor`` where each expansion ends; ``slip`` the slip direction of each
     frictional contact (0: sticking or frictionless); ``primary`` the contact whose impulse is
     the independent variable (-1: time); ``rest`` the speed that counts as zero; ``stick`` the
-    sticking contacts and ``stick_solve`` the pseudo-inverse that gives their forces.
+    sticking contacts and ``stick_block`` their tangential Delassus block.
     """
 
     phase: np.ndarray
@@ -88,6 +88,7 @@ class Segment:
     primary: int
     rest: float
     stick: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    stick_block: np.ndarray | None = None
     stick_solve: np.ndarray | None = None
 
     def __post_init__(self) -> None:
@@ -98,6 +99,27 @@ class Segment:
         self.expanding = self.phase == EXPANSION
         self.loaded = self.phase != IDLE
         self.acting = np.flatnonzero(self.loaded)
+
+    def hold(self, stick: np.ndarray, Ctt: np.ndarray) -> None:
+        """Make ``stick`` the sticking contacts, ``Ctt`` the tangential Delassus matrix."""
+        self.stick = stick
+        self.stick_block = Ctt[np.ix_(stick, stick)]
+        independent = np.linalg.matrix_rank(self.stick_block) == stick.size
+        self.stick_solve = np.linalg.inv(self.stick_block) if independent else None
+
+    def stick_forces(self, drive: np.ndarray, bound: np.ndarray) -> np.ndarray:
+        """Tangential forces that hold the sticking contacts at rest against ``drive``.
+
+        Unique when their tangential directions are independent. When they are not (two
+        corners of a block on one floor line share a tangential velocity) only the sum along
+        the shared directions is decided: each contact then takes a share in proportion to
+        its cone's bound ``mu Fn``, ``x = -B A (A B A)^+ drive``, so a contact that carries no
+        normal force carries no friction and every shared cone is reached at once.
+        """
+        if self.stick_solve is not None:
+            return -self.stick_solve @ drive
+        weighted = bound[:, None] * self.stick_block
+        return -weighted @ np.linalg.pinv(self.stick_block @ weighted, rcond=1e-12) @ drive
 
 
 class EnergeticImpact:
@@ -207,7 +229,7 @@ class EnergeticImpact:
         if seg.stick.size:
             m = self.m
             drive = self.C[m:, :m] @ Fn + self.C[m:, m:] @ Ft
-            Ft[seg.stick] = -seg.stick_solve @ drive[seg.stick]
+            Ft[seg.stick] = seg.stick_forces(drive[seg.stick], self.mu[seg.stick] * Fn[seg.stick])
         return Fn, Ft
 
     def rate(self, y: np.ndarray, seg: Segment) -> np.ndarray:
@@ -398,9 +420,7 @@ class EnergeticImpact:
         scale = max(float(np.abs(drive).max()), float(np.abs(A @ Ft).max()), 1e-300)
         slipping = np.abs(accel) > 1e-9 * scale
         seg.slip[rest[slipping]] = np.sign(accel[slipping])
-        seg.stick = rest[~slipping]
-        if seg.stick.size:
-            seg.stick_solve = np.linalg.pinv(Ctt[np.ix_(seg.stick, seg.stick)], rcond=1e-12)
+        seg.hold(rest[~slipping], Ctt)
 
     # --- the driver ---------------------------------------------------------------------------
 
