@@ -40,6 +40,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import STUDIES
 from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, Params, Reference, per_item
@@ -89,6 +90,12 @@ def _straight_shot(p: Params) -> np.ndarray:
 def _straight_condition(p: Params) -> str | None:
     if p["elevation"] != 0 or p["offset_side"] != 0 or p["offset_height"] != 0:
         return "needs a horizontal shot through the centre"
+    cue, table = p["mu"]
+    if cue * table >= 1:
+        # The cue's friction can press the ball into the table and the table's friction
+        # hold it back: the two cones, at right angles, meet (atan mu_cue + atan mu_table
+        # >= 90 degrees), and the rigid problem also has the wedged answer.
+        return "needs mu_cue mu_table < 1: otherwise the ball can wedge between cue and table"
     return None
 
 
@@ -117,6 +124,10 @@ class Billiard(Case):
         exponent_spec(),
     )
     requires = Tags(friction=True, several_contacts=True, spatial=True)
+    ground_truth = springs_with_friction(
+        "the cue's compliance against the table's decides how the two contacts share the "
+        "impact, and the cue's tip grips or slides on the ball (Jia 2013)"
+    )
     references = (
         Reference(
             "straight shot",

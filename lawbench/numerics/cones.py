@@ -34,6 +34,8 @@ from lawbench.core.errors import SolverFailure
 from lawbench.numerics.solvers import clarabel_settings
 
 NEWTON_STEPS = 30
+# A slip speed below this fraction of the largest pre-impact speed is read as no slip.
+ZERO_SLIP = 1e-6
 EPS = np.finfo(float).eps
 
 
@@ -181,6 +183,7 @@ def _states(
     m = len(mu)
     Pn, Pt = split(P, m, d)
     un, ut = split(modified_velocity(G, q, mu, d, P, coupled), m, d)
+    scale = max(float(np.abs(q).max()), 1e-300)
     states = []
     for j in range(m):
         g = G[j, j]
@@ -191,7 +194,9 @@ def _states(
         z0, zt = un[j] / mu[j], float(np.linalg.norm(ut[j]))
         if x0 + xt < z0 - zt:
             states.append("free")
-        elif z0 + zt < x0 - xt:
+        elif z0 + zt < x0 - xt or zt <= ZERO_SLIP * scale:
+            # A slip speed within the interior point's accuracy gives no slip direction: the
+            # contact sticks (the residual test of `polish` then decides).
             states.append("stick")
         else:
             states.append("slip")
@@ -267,7 +272,12 @@ def polish(
     free = ~_fixed(mu, d, states)
     exact = np.where(free, P, 0.0)
     for _ in range(NEWTON_STEPS):
-        F, J = _newton_system(G, q, mu, d, exact, coupled, states)
+        # A slip whose speed Newton's steps drive to zero leaves its direction undecided: the
+        # approximate solution then stands.
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            F, J = _newton_system(G, q, mu, d, exact, coupled, states)
+        if not (np.isfinite(F).all() and np.isfinite(J).all()):
+            return None
         step = np.linalg.lstsq(J[np.ix_(free, free)], -F[free], rcond=None)[0]
         exact[free] += step
         if not step.size or np.abs(step).max() <= 4 * EPS * max(np.abs(exact).max(), 1e-300):
