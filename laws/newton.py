@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.checks.regions import separating_contact
+from lawbench.checks.regions import resting_contact, separating_contact
 from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import is_diagonal
@@ -69,6 +69,16 @@ class Newton(Law):
             _SOURCE,
             "holding a separating contact to un+ = -e un- needs a tensile impulse",
             (("three_ball_chain", "separating contact"),),
+        ),
+        Claim(
+            "impulse_sign",
+            resting_contact,
+            "Brogliato 2010, eq. (29) and the rocking block (Housner 1963): the pivot that "
+            "does not separate before the landing",
+            "a contact at rest is held at un+ = -e un- = 0: where the impact of another "
+            "contact would lift it (the rocking block's pivot) only a tensile impulse keeps it "
+            "down, -5.8 N s on the elastic frictionless block",
+            (("rocking_block", "elastic frictionless"),),
         ),
     )
     guarantees = (

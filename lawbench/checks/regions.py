@@ -14,10 +14,13 @@ from typing import Any
 import numpy as np
 
 from lawbench.core.mechanics import kinetic_angles, separating_contacts
+from lawbench.core.problem import is_sparse
 from lawbench.core.verdicts import EVERYWHERE, Region
 
 # Relative size of a normal-tangential Delassus entry that counts as coupling.
 COUPLING = 1e-9
+# A contact's gap rate below this fraction of the largest one counts as rest.
+REST = 1e-12
 # Kinetic angles within this many degrees of 90 count as orthogonal.
 ORTHOGONAL_DEG = 1e-6
 
@@ -32,6 +35,7 @@ __all__ = [
     "oblique_contacts",
     "option",
     "recompressed_contact",
+    "resting_contact",
     "separating_contact",
 ]
 
@@ -41,6 +45,24 @@ def _separating(trial: Any) -> bool:
 
 
 separating_contact = Region("a closed contact separates before the impact", _separating)
+
+def _resting(trial: Any) -> bool:
+    problem = trial.problem
+    un, closed = np.asarray(problem.un), np.asarray(problem.closed)
+    scale = max(float(np.abs(un).max()), 1e-300)
+    resting = np.flatnonzero(closed & (np.abs(un) <= REST * scale))
+    approaching = np.flatnonzero(closed & (un < -REST * scale))
+    if resting.size == 0 or approaching.size == 0:
+        return False
+    G = problem.delassus
+    G = G.toarray() if is_sparse(G) else np.asarray(G)
+    return bool(np.abs(G[np.ix_(resting, approaching)]).max() > COUPLING * np.abs(G).max())
+
+
+resting_contact = Region(
+    "a closed contact at rest before the impact (un- = 0), coupled to one that approaches",
+    _resting,
+)
 
 frictional = Region("some contact has friction", lambda trial: trial.problem.frictional)
 frictionless = ~frictional
