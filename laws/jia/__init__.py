@@ -43,8 +43,8 @@ Formulations (``diagnostics['formulation']``): frictionless with a diagonal Dela
 contact included), the closed form ``Pn = -(1 + e) un- / G_jj`` (the energetic coefficient
 equals Newton's there); otherwise the spring equations integrated with scipy's DOP853 at the
 relative ``tol``, every transition (end of compression, slip, stick, separation,
-reactivation, lock, release) an event; a gap rate above ``-100 tol |u-|`` does not count
-as approaching. Diagnostics: ``sequence`` (one contact: the modes and events, for
+reactivation, lock, release) an event; a gap rate above ``-100 tol |u-|`` (at most 1 % of
+``|u-|``) does not count as approaching. Diagnostics: ``sequence`` (one contact: the modes and events, for
 example slip, stick, end of compression, slip, end of impact; several: the active sets),
 ``events`` (each transition with its ``tau`` and normal impulses), ``steps`` (integrator
 steps), ``compression_loss`` (J, energy taken at the ends of compression), ``recompressed``
@@ -204,9 +204,10 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
     Pt = state[2 * m : 2 * m + d] if d else None
     Pn = state[:m]
     if not d:
-        # A contact left approaching slower than the reactivation threshold (100 tol times the
-        # largest speed) would be reactivated with negligible energy and stopped: its limit,
-        # a plastic stop, keeps the outcome admissible at the cost of an O(tol) impulse.
+        # A contact left approaching slower than the reactivation threshold (100 tol, at most
+        # 1 %, times the largest speed) would be reactivated with negligible energy and
+        # stopped: its limit, a plastic stop, keeps the outcome admissible at the cost of an
+        # impulse of that order.
         after = problem.un + problem.delassus @ Pn
         if (after < 0).any():
             stop = solve_lcp(problem.delassus, after).z

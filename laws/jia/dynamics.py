@@ -67,9 +67,11 @@ from lawbench.core.errors import SolverFailure
 from lawbench.core.mechanics import for_products
 from lawbench.numerics.integrator import EventIntegrator
 
-# Gap rates above -max(ROUNDING, 100 tolerance) |u-| count as not approaching: a grazing
-# contact is not reactivated by the integration's noise.
+# Gap rates above -min(max(ROUNDING, 100 tolerance), NOT_APPROACHING) |u-| count as not
+# approaching: a grazing contact is not reactivated by the integration's noise, and at a loose
+# tolerance a contact that approaches at more than 1 % of the largest speed still acts.
 ROUNDING = 1e-12
+NOT_APPROACHING = 1e-2
 # A contact this much stiffer than the softest other loaded spring is rigid (see above).
 LOCK = 1e6
 # A segment with no event within this many natural periods does not end.
@@ -144,7 +146,8 @@ class SpringImpact:
         self.d = G.shape[0] - self.m
         self.tolerance, self.keep_path = tolerance, keep_path
         self.kappa = springs.kappa.astype(float).copy()
-        self.approach = max(ROUNDING, 100 * tolerance) * float(np.abs(u_minus).max())
+        threshold = min(max(ROUNDING, 100 * tolerance), NOT_APPROACHING)
+        self.approach = threshold * float(np.abs(u_minus).max())
         self.active = u_minus[: self.m] < -self.approach
         self.compressing = self.active.copy()
         # Rigid contacts: locked (holding the gap rate), or rigid but released.
