@@ -1,20 +1,23 @@
-"""The ground truth of the scenes with one frictional contact: Darboux-Keller, Stronge's end."""
+"""The ground truth of the frictional scenes: compliant contact with friction, in time."""
 
 from __future__ import annotations
 
 from lawbench.core.case import GroundTruth
 
 
-def stronge(detail: str) -> GroundTruth:
-    """Darboux-Keller impulse dynamics with Stronge's termination, for one frictional contact.
+def springs_with_friction(detail: str) -> GroundTruth:
+    """Compliant contacts with tangential springs and Coulomb sliders, integrated in time.
 
     ``detail`` says what the scene adds to the reason.
     """
     return GroundTruth(
-        why="Coulomb friction resolved along the normal impulse (Darboux-Keller): stick, slip "
-        "and slip reversal as they happen during the impact, which impulse-level laws do not "
-        "follow; Stronge's energetic termination is the one that never creates energy "
-        f"(Stronge 1990; Brogliato 2010, eqs. 12-15); {detail}",
-        law="darboux_keller",
-        options={"termination": "energetic", "tol": 1e-12},
+        why="each contact a unilateral normal force law (Hunt-Crossley, its damping from e by "
+        "Flores' rule, at the scene's stiffnesses) with a tangential spring in series with a "
+        "Coulomb slider, integrated in time: stick, slip and slip reversal happen as the "
+        "forces decide, during the impact, and several contacts share it as their stiffnesses "
+        "decide, which no impulse-level law follows (Jia, IJRR 2013, the same springs in "
+        "impulse space; Brogliato 2010, compliant contacts); it never creates energy, and "
+        f"no such model reaches e = 0; {detail}",
+        law="compliant",
+        options={"tol": 1e-10},
     )

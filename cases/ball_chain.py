@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
-from lawbench.checks.declared import STUDIES, decades, extremes
+from lawbench.checks.declared import STUDIES, decades, extremes, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.problem import ImpactProblem
@@ -132,3 +132,4 @@ STUDIES.register(
         full={"grid": {"masses": [[r, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
     )
 )
+STUDIES.register(speed_accuracy("ball_chain"))

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import STUDIES
+from lawbench.checks.declared import STUDIES, speed_accuracy
 from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, Params, Reference, per_item
 from lawbench.core.errors import InvalidProblem
@@ -284,3 +284,4 @@ STUDIES.register(
         view="sweep",
     )
 )
+STUDIES.register(speed_accuracy("billiard"))

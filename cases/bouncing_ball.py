@@ -33,20 +33,18 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.checks.declared import STUDIES, large_friction
-from lawbench.core.case import CASES, Case, GroundTruth, Params, Reference, exactly
+from lawbench.cases._friction import springs_with_friction
+from lawbench.checks.declared import STUDIES, large_friction, speed_accuracy
+from lawbench.core.case import CASES, Case, Params, Reference, exactly
 from lawbench.core.problem import MINDLIN_RATIO, Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.numerics.rigid import spatial_column
 
 # Jia's scenes are stated in his model: its tangential compliance at the scene's eta0^2.
-TANGENTIAL_COMPLIANCE = GroundTruth(
-    why="the example is stated in Jia's model: normal and tangential springs at the contact "
-    "whose stiffness ratio eta0^2 is a parameter of the scene, which rigid Coulomb laws do not "
-    "read (Jia, IJRR 2013); the law integrated at its tightest tolerance",
-    law="jia",
-    options={"tol": 1e-12},
+TANGENTIAL_COMPLIANCE = springs_with_friction(
+    "the tangential spring's stiffness ratio eta0^2 is a parameter of the scene, which rigid "
+    "Coulomb laws do not read"
 )
 COORDINATES = ["vx [m/s]", "vy [m/s]", "vz [m/s]", "wx [rad/s]", "wy [rad/s]", "wz [rad/s]"]
 
@@ -201,3 +199,4 @@ class BouncingBall(Case):
 BouncingBall.references = (frictionless_reference(BouncingBall),)
 CASES.register(BouncingBall())
 STUDIES.register(large_friction("bouncing_ball"))
+STUDIES.register(speed_accuracy("bouncing_ball"))

@@ -42,7 +42,7 @@ from lawbench.cases.bouncing_ball import (
     frictionless_reference,
     vector_spec,
 )
-from lawbench.checks.declared import STUDIES, large_friction
+from lawbench.checks.declared import STUDIES, large_friction, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, exactly
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
@@ -157,3 +157,4 @@ class BouncingPencil(Case):
 BouncingPencil.references = (frictionless_reference(BouncingPencil),)
 CASES.register(BouncingPencil())
 STUDIES.register(large_friction("bouncing_pencil"))
+STUDIES.register(speed_accuracy("bouncing_pencil"))

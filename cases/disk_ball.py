@@ -49,9 +49,10 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.checks.declared import STUDIES, impact_paths
+from lawbench.cases._friction import springs_with_friction
+from lawbench.checks.declared import STUDIES, impact_paths, speed_accuracy
 from lawbench.checks.study import Study
-from lawbench.core.case import CASES, Case, GroundTruth, Params, per_item
+from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
@@ -125,11 +126,9 @@ class DiskBall(Case):
         exponent_spec(),
     )
     requires = Tags(friction=True, several_contacts=True)
-    ground_truth = GroundTruth(
-        why="the source resolves the impact with the energetic multiple-impact law and Coulomb "
-        "friction at every contact (Zhang et al. 2013), and matches its experiments with it",
-        law="lzb",
-        options={"tol": 1e-10},
+    ground_truth = springs_with_friction(
+        "the source resolves the impact with the energetic multiple-impact law, whose "
+        "stiffness ratios and exponent are the springs' own (Zhang et al. 2013)"
     )
     examples = {
         "default": {},
@@ -253,3 +252,4 @@ STUDIES.register(
         {"stored_energy_peaks": stored_energy_peaks, "primary_contacts": primary_contacts},
     )
 )
+STUDIES.register(speed_accuracy("disk_ball"))

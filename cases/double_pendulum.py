@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases._friction import stronge
-from lawbench.checks.declared import STUDIES, energy_map, large_friction
+from lawbench.cases._friction import springs_with_friction
+from lawbench.checks.declared import STUDIES, energy_map, large_friction, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, exactly
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
@@ -101,9 +101,9 @@ class DoublePendulum(Case):
         Spec("mu", 0.5, "Coulomb friction coefficient", "", "float", 0.0),
     )
     requires = Tags(friction=True)
-    ground_truth = stronge(
-        "Kane and Levinson's pendulum is the classic case where the impulse-level law gains "
-        "energy and the impulse-time dynamics do not"
+    ground_truth = springs_with_friction(
+        "Kane and Levinson's pendulum is the classic case where an impulse-level law gains "
+        "energy, which the springs cannot"
     )
     examples = {
         "default": {},
@@ -137,3 +137,4 @@ CASES.register(DoublePendulum())
 
 STUDIES.register(energy_map("double_pendulum", ("e", 0.0, 1.0), ("mu", 0.0, 1.5)))
 STUDIES.register(large_friction("double_pendulum"))
+STUDIES.register(speed_accuracy("double_pendulum"))

@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases._friction import stronge
+from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import (
     STUDIES,
     duplicated_contact,
@@ -185,7 +185,7 @@ class FallingRod(Case):
         Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
     )
     requires = Tags(friction=True)
-    ground_truth = stronge(
+    ground_truth = springs_with_friction(
         "on the rod the normal-tangential coupling can reverse the slip (the remark after eq. 9)"
     )
     references = (

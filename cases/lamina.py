@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases._friction import stronge
+from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import (
     STUDIES,
     duplicated_contact,
@@ -121,10 +121,9 @@ class Lamina(Case):
         Spec("mu", 0.5, "Coulomb friction coefficient", "", low=0.0),
     )
     requires = Tags(friction=True)
-    ground_truth = stronge(
-        "on the lamina the energetic coefficient is the energetically consistent one (a "
-        "Newton coefficient can exceed it and create energy), and Lubarda's closed form "
-        "-e sqrt(r) omega- is its answer wherever the lamina rebounds"
+    ground_truth = springs_with_friction(
+        "on the lamina the slip can stop and stick during the impact, which decides between "
+        "Lubarda's closed forms (one per termination of the rigid impulse dynamics)"
     )
     references = (
         _termination("newton", lambda r: 1.0, "-e omega-"),

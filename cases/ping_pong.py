@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.cases.two_balls_wall import TwoBallsWall
-from lawbench.checks.declared import STUDIES
+from lawbench.checks.declared import STUDIES, speed_accuracy
 from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Params
 from lawbench.core.spec import Spec
@@ -141,3 +141,4 @@ STUDIES.register(
         view="sweep",
     )
 )
+STUDIES.register(speed_accuracy("ping_pong"))

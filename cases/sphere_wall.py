@@ -30,8 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases._friction import stronge
-from lawbench.checks.declared import STUDIES, grazing, large_friction
+from lawbench.cases._friction import springs_with_friction
+from lawbench.checks.declared import STUDIES, grazing, large_friction, speed_accuracy
 from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, Params, Reference, exactly
 from lawbench.core.problem import Contact, ImpactProblem
@@ -109,7 +109,7 @@ class SphereWall(Case):
         Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
     )
     requires = Tags(friction=True, spatial=True)
-    ground_truth = stronge("on the sphere the slip direction turns during the impact")
+    ground_truth = springs_with_friction("on the sphere the slip direction turns during the impact")
     references = (
         Reference(
             "eq. (11)",
@@ -205,7 +205,11 @@ STUDIES.register(
             "spin_plus": spin_after,
             "impulse_ratio": impulse_ratio,
         },
+        axes=("angle", "ut_plus", "spin_plus", "impulse_ratio"),
+        units={"ut_plus": "m/s", "spin_plus": "rad/s", "impulse_ratio": ""},
+        view="sweep",
     )
 )
 STUDIES.register(large_friction("sphere_wall"))
 STUDIES.register(grazing("sphere_wall", [0.0, 1.0], slow=True))
+STUDIES.register(speed_accuracy("sphere_wall"))

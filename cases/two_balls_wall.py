@@ -24,6 +24,7 @@ from lawbench.checks.declared import (
     energy_shares,
     extremes,
     grazing,
+    speed_accuracy,
 )
 from lawbench.core.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.core.problem import ImpactProblem
@@ -178,3 +179,4 @@ for study in (
     duplicated_contact("two_balls_wall", _ELASTIC_AND_PLASTIC["e"], slow=True),
 ):
     STUDIES.register(study)
+STUDIES.register(speed_accuracy("two_balls_wall"))

@@ -467,7 +467,12 @@ def test_a_solve_of_built_in_entries_reads_no_metadata_and_no_batch_code(module)
 
 def test_describe_names_every_scenes_ground_truth():
     """A scene's outcomes are measured against its declared ground truth: describe prints it,
-    with why, on a line of its own."""
+    with why, on a line of its own. Every scene has one, and none is a rigid law under test:
+    a closed form, or the time-domain model of compliant contact."""
+    for case in lawbench.CASES.values():
+        truth = case.ground_truth
+        assert truth is not None, case.name
+        assert truth.law in (None, "compliant"), (case.name, truth.law)
     commands = [[sys.executable, "-m", "lawbench", "describe", name] for name in CASES]
     for name, done in zip(CASES, run_together(*commands), strict=True):
         assert done.returncode == 0, done.stderr

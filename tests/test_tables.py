@@ -260,7 +260,7 @@ def test_a_sweep_draws_each_measure_against_its_axis_per_law():
     study = STUDIES.get("billiard")
     with Executor() as pool:
         table = collect(study.plan(laws=["moreau"]), pool)
-    frame = sweeps._tidy(table, "elevation", list(study.measures))
+    frame = sweeps._tidy(table, "elevation", list(study.measures), [])
     assert set(frame["law"]) == {"moreau"}
     assert sorted(frame["elevation"]) == [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]
     assert {"ball_speed", "spin[0]", "spin[2]", "spin_tilt"} <= set(frame.columns)
@@ -298,7 +298,7 @@ def test_a_sweep_over_decades_draws_a_log_abscissa():
     study = dataclasses.replace(study, laws=("sequential",))
     with Executor() as pool:
         table = collect(study.plan(), pool)
-    frame = sweeps._tidy(table, "stiffness_ratio", list(study.measures))
+    frame = sweeps._tidy(table, "stiffness_ratio", list(study.measures), [])
     units = {**study.units, "stiffness_ratio": ""}
     figure = sweeps._figure("ping_pong", study.title, frame, "stiffness_ratio", units)
     shown = [ax for ax in figure.figure.axes if ax.get_visible()]

@@ -3,7 +3,8 @@
 *Model error* and *numerical error* are two different measures, never one column:
 
 - `model_error`: the distance of the outcome from the scene's ground truth
-  (``Case.ground_truth``: a closed-form `Reference`, or a converged solution of a stated model),
+  (``Case.ground_truth``: a closed-form `Reference` where it holds, else a converged solution of
+  a stated model),
   ``max |v+ - v_truth| / max |v-|``;
 - `numerical_error`: the distance from the law's own answer at its tightest accuracy knob
   (`lawbench.checks.study.tightest`), the same way; 0 for an exact law, None for a knob that chooses
@@ -69,19 +70,28 @@ def truth(trial: Trial) -> np.ndarray | None:
     """The scene's ground truth on this trial's problem, or None where it has none.
 
     A closed form holds at the scene's own parameters only: not on a transformed problem, nor
-    where its condition fails.
+    where its condition fails; there the scene's model, if it declares one, is the truth.
     """
     case = trial.case
     ground = case.ground_truth if case is not None else None
     if ground is None:
         return None
+    if ground.reference is not None:
+        closed = _closed_form(trial, ground.reference)
+        if closed is not None:
+            return closed
     if ground.law is not None:
         return _solve(ground.law, dict(ground.options), trial.problem)
-    reference = next(r for r in case.references if r.name == ground.reference)
-    built = case.build(**trial.params)
-    if _digest(built) != _digest(trial.problem) or reference.condition(trial.params):
+    return None
+
+
+def _closed_form(trial: Trial, name: str) -> np.ndarray | None:
+    """The case's reference ``name`` on this trial, None where it does not hold."""
+    case = trial.case
+    reference = next(r for r in case.references if r.name == name)
+    if reference.condition(trial.params) or any(trial.params.get("gaps", ())):
         return None
-    if any(trial.params.get("gaps", ())):
+    if _digest(case.build(**trial.params)) != _digest(trial.problem):
         return None
     return np.asarray(reference.v_plus(trial.params), dtype=float)
 

@@ -46,6 +46,7 @@ def _separating(trial: Any) -> bool:
 
 separating_contact = Region("a closed contact separates before the impact", _separating)
 
+
 def _resting(trial: Any) -> bool:
     problem = trial.problem
     un, closed = np.asarray(problem.un), np.asarray(problem.closed)

@@ -68,18 +68,22 @@ class Reference:
 
 @dataclass(frozen=True)
 class GroundTruth:
-    """What a scene's outcomes are measured against: a closed form or a converged model.
+    """What a scene's outcomes are measured against: a closed form, a converged model, or both.
+
+    With both, the closed form is the truth where its condition holds (it is exact there) and
+    the model everywhere else.
 
     Attributes
     ----------
     why : str
         Why this is the truth of the scene (which physics it resolves that the others do not).
     reference : str or None
-        The name of one of the case's `Reference` closed forms, when the truth is exact.
+        The name of one of the case's `Reference` closed forms, exact where it holds.
     law : str or None
-        Otherwise the law whose converged solution is the truth (a stated model).
+        The model whose converged solution is the truth (elsewhere, when there is a closed
+        form): a stated model, never one of the rigid laws compared on the scene.
     options : mapping
-        That law's options for the converged solution (its tightest accuracy knob).
+        That model's options for the converged solution (its tightest accuracy knob).
     """
 
     why: str
@@ -89,12 +93,14 @@ class GroundTruth:
 
     def describe(self) -> str:
         """A short label for table headers."""
-        if self.reference is not None:
-            return f"closed form ({self.reference})"
         settings = ", ".join(
             f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.options.items()
         )
-        return f"{self.law} ({settings})" if settings else str(self.law)
+        model = f"{self.law} ({settings})" if settings else str(self.law)
+        if self.reference is None:
+            return model
+        closed = f"closed form ({self.reference})"
+        return closed if self.law is None else f"{closed} where it holds, else {model}"
 
 
 class Case(ABC):

@@ -92,48 +92,70 @@ def _save(config: Config) -> Any:
     return save
 
 
+# The verdicts the headline counts, each with the name of its list and what it asks of a reader.
+COUNTED = {
+    Verdict.UNEXPLAINED: (
+        "unexplained",
+        "unexplained",
+        "each is a bug to fix or a finding to write",
+    ),
+    Verdict.NUMERICAL_FAILURE: (
+        "numerical_failures",
+        "numerical failures",
+        "an answer that breaks what its law promises",
+    ),
+    Verdict.BUDGET: ("budgets", "budgets", "a cell stopped by a budget it names"),
+}
+
+
+def _why(row: dict[str, Any], checks: list[str], verdict: Verdict) -> str:
+    if row["error_class"]:
+        return f"{row['error_class']}: {row['error_message']}"
+    return "; ".join(
+        f"{c}: {row[f'{c}_detail']}" for c in checks if row[f"{c}_verdict"] == str(verdict)
+    )
+
+
 def headline(ctx: Context) -> list[Any]:
-    """The count of *unexplained* cells over every study, and each with its reproducer."""
-    rows = []
+    """The counts of unexplained cells, numerical failures and budgets, each with its list.
+
+    Every listed cell has the command that reruns it and the exit status that command gives.
+    """
+    lists: dict[Verdict, list[dict[str, Any]]] = {verdict: [] for verdict in COUNTED}
     for study, table in ctx.every_table():
         table = table.fillna({"error_class": ""})
-        bad = table[(table["verdict"] == str(Verdict.UNEXPLAINED)) & (table["repeat"] == 0)]
         checks = study.check_names()
-        for row in bad.to_dict("records"):
-            if row["error_class"]:
-                why = f"{row['error_class']}: {row['error_message']}"
-            else:
-                why = "; ".join(
-                    f"{c}: {row[f'{c}_detail']}"
-                    for c in checks
-                    if row[f"{c}_verdict"] == str(Verdict.UNEXPLAINED)
-                )
-            rows.append(
+        for row in table[table["repeat"] == 0].to_dict("records"):
+            verdict = next((v for v in COUNTED if row["verdict"] == str(v)), None)
+            if verdict is None:
+                continue
+            lists[verdict].append(
                 {
                     "study": study.name,
                     "law": row["law"],
                     "scene": row["case"],
                     "cell": label(json.loads(row["params"]), skip=()) or "defaults",
-                    "why": why,
+                    "why": _why(row, checks, verdict),
                     "reproducer": row["reproducer"],
                     "exit status": row["exit_status"],
                 }
             )
-    cells = sum(len(t) for _, t in ctx.every_table())
-    if not rows:
-        return [f"No unexplained cell among the {cells} cells of {len(ctx.studies)} studies."]
-    return [
-        f"{len(rows)} unexplained cells among the {cells} cells of {len(ctx.studies)} "
-        "studies: each is a bug to fix or a finding to write. Each is listed with a command "
-        "that reruns it and exits with the status shown (0 answered, 3 refused, 4 budget or "
-        "solver failure).",
-        Table(
-            "unexplained",
-            "Every unexplained cell of the report, with why and its reproducer.",
-            pd.DataFrame(rows),
-            commands=("reproducer",),
-        ),
+    cells = sum(len(t[t["repeat"] == 0]) for _, t in ctx.every_table())
+    counts = ", ".join(
+        f"[{len(lists[verdict])} {plural}](#{name})" if lists[verdict] else f"0 {plural}"
+        for verdict, (name, plural, _) in COUNTED.items()
+    )
+    blocks: list[Any] = [
+        f"Among the {cells} cells of {len(ctx.studies)} studies: {counts}. Each listed cell "
+        "comes with a command that reruns it and exits with the status shown (0 answered, "
+        "3 refused, 4 budget or solver failure)."
     ]
+    for verdict, (name, _, meaning) in COUNTED.items():
+        if lists[verdict]:
+            caption = f"Every cell of the report whose verdict is {verdict} ({meaning})."
+            frame = pd.DataFrame(lists[verdict])
+            blocks.append(Table(name, caption, frame, commands=("reproducer",)))
+    return blocks
 
 
 def _preamble(ctx: Context, config: Config, seconds: float) -> list[str]:
@@ -148,4 +170,13 @@ def _preamble(ctx: Context, config: Config, seconds: float) -> list[str]:
         f"lawbench {version('lawbench')}, Python {platform.python_version()}, numpy "
         f"{np.__version__}, scipy {scipy.__version__}, matplotlib {matplotlib.__version__}.",
         *dict.fromkeys(f"Note: {note}." for note in ctx.notes),
+        *(
+            [
+                "Declared studies left out of this page: "
+                + "; ".join(f"`{name}`: {why}" for name, why in ctx.left_out.items())
+                + "."
+            ]
+            if ctx.left_out
+            else []
+        ),
     ]

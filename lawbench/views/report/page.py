@@ -32,7 +32,7 @@ STYLE = """
 body { font-family: sans-serif; max-width: 1200px; margin: 2em auto; padding: 0 1em; }
 table { border-collapse: collapse; margin: 1em 0; font-size: 0.85em; }
 th, td { border: 1px solid #bbb; padding: 0.2em 0.5em; vertical-align: top; }
-th { background: #eee; }
+th { background: #eee; overflow-wrap: anywhere; }
 figure { margin: 1.5em 0; }
 figure img { max-width: 100%; }
 figcaption, .caption { font-size: 0.9em; color: #333; }
@@ -59,7 +59,8 @@ PARTS = {
     "text": "<p>{{ block | inline }}</p>",
     "legend": '<p class="legend">{% for m in block.marks %}{{ mark(m) }}'
     "<span> {{ m.reason }}</span><br>{% endfor %}</p>",
-    "table": '<table{% if block.css %} class="{{ block.css }}"{% endif %}><thead><tr>'
+    "table": '<table id="{{ block.name }}"{% if block.css %} class="{{ block.css }}"{% endif %}>'
+    "<thead><tr>"
     "{% for c in block.frame.columns %}<th>{{ c }}</th>{% endfor %}</tr></thead><tbody>"
     '{% for row in rows %}<tr{% if row.anchor %} id="{{ row.anchor }}"{% endif %}>'
     "{% for c in row.cells %}<td>{{ c }}</td>{% endfor %}</tr>{% endfor %}</tbody></table>"
@@ -210,7 +211,11 @@ def _markdown(block: Block, rerun: str) -> str:
     if isinstance(block, Figure):
         return f"![{block.name}]({block.name}.png)\n\n{caption}"
     frame = block.frame
-    lines = ["| " + " | ".join(map(str, frame.columns)) + " |", "|" + "---|" * len(frame.columns)]
+    lines = [
+        f'<a id="{block.name}"></a>\n',
+        "| " + " | ".join(map(str, frame.columns)) + " |",
+        "|" + "---|" * len(frame.columns),
+    ]
     for _, row in frame.iterrows():
         cells = [_markdown_cell(v, c in block.commands) for c, v in row.items()]
         if block.anchors:

@@ -92,6 +92,8 @@ class Context:
         self.cases, case_notes = registered(CASES, config.cases)
         self.notes = law_notes + case_notes
         self.studies: list[Study] = []
+        # Declared studies this page does not run -> why.
+        self.left_out: dict[str, str] = {}
         self._tables: dict[str, pd.DataFrame] = {}
 
     @property
@@ -114,15 +116,24 @@ class Context:
         cases = [case.name for case in self.cases]
         plans = []
         for study in STUDIES.values():
-            if study.view not in views or (study.slow and not full):
+            if study.view not in views:
+                self.left_out[study.name] = f"no section draws it (`lawbench study {study.name}`)"
+                continue
+            if study.slow and not full:
+                self.left_out[study.name] = (
+                    "a slow study, in the full report (`lawbench report --full`)"
+                )
                 continue
             if config.studies is not None and study.name not in config.studies:
+                self.left_out[study.name] = "not among the studies asked for"
                 continue
             study = study.preset(config.mode)
             plan = study.plan(laws, cases)
             if plan.jobs:
                 self.studies.append(study)
                 plans.append((plan, self.out / "runs" / f"{study.name}.parquet"))
+            else:
+                self.left_out[study.name] = "none of its laws and scenes is selected"
         if not full:
             shutil.rmtree(self.out / "runs", ignore_errors=True)
         executor = Executor(

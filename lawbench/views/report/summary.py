@@ -1,10 +1,10 @@
 """Section 1, the summary matrix: laws x scenes, the verdict of every check at the defaults.
 
 A view of the ``summary`` study: every law on every scene at its default parameters, with every
-check (continuity and dispersion included). Each cell holds one mark per check, its symbol from
-the key and its colour from the verdict class; a *law property* links to the finding that
-predicts it. A law that refuses the scene gets one *refused* mark, like a check that does not
-apply.
+check (continuity and dispersion included). Each cell holds one mark, the worst verdict of its
+checks, with the symbols of the checks that have it and every check's reason on hover, so the
+matrix fits a page; a *law property* links to the finding that predicts it. A law that refuses
+the scene gets one *refused* mark, like a check that does not apply.
 """
 
 from __future__ import annotations
@@ -68,17 +68,32 @@ def failure(row: dict[str, Any]) -> str:
     return f"{row['error_class']}: {row['error_message']}" + (f" ({budget})" if budget else "")
 
 
-def _marks(row: dict[str, Any], checks: list[str], short: dict, by_key: dict) -> list[Mark]:
+# The verdict a cell shows: the worst of its checks, in this order.
+WORST_FIRST = (
+    Verdict.UNEXPLAINED,
+    Verdict.NUMERICAL_FAILURE,
+    Verdict.BUDGET,
+    Verdict.LAW_PROPERTY,
+    Verdict.HOLDS,
+    Verdict.REFUSED,
+)
+
+
+def _mark(row: dict[str, Any], checks: list[str], short: dict, by_key: dict) -> Mark:
+    """The cell's one mark: its worst verdict, the checks that have it, every reason on hover.
+
+    A law property links to the finding that predicts it.
+    """
     if row["error_class"]:
-        return [Mark("", Verdict(row["verdict"]), failure(row))]
-    marks = []
-    for check in checks:
-        verdict = Verdict(row[f"{check}_verdict"])
-        reason = f"{check}: {row[f'{check}_detail']}"
-        found = by_key.get((row["law"], row[f"{check}_finding"]))
-        link = f"#{found['anchor']}" if verdict == Verdict.LAW_PROPERTY and found else ""
-        marks.append(Mark(short[check], verdict, reason, link))
-    return marks
+        return Mark("", Verdict(row["verdict"]), failure(row))
+    verdicts = {check: Verdict(row[f"{check}_verdict"]) for check in checks}
+    worst = next(v for v in WORST_FIRST if v in verdicts.values())
+    named = [c for c in checks if verdicts[c] == worst]
+    text = "" if worst in (Verdict.HOLDS, Verdict.REFUSED) else " ".join(short[c] for c in named)
+    reason = "; ".join(f"{c}: {verdicts[c]}: {row[f'{c}_detail']}" for c in checks)
+    found = by_key.get((row["law"], row[f"{named[0]}_finding"]))
+    link = f"#{found['anchor']}" if worst == Verdict.LAW_PROPERTY and found else ""
+    return Mark(text, worst, reason, link)
 
 
 def build(ctx: Context) -> Section:
@@ -100,7 +115,7 @@ def build(ctx: Context) -> Section:
             row = rows.get((law.name, case.name))
             if row is None:
                 continue
-            matrix[law.name][case.name] = _marks(row, checks, short, by_key)
+            matrix[law.name][case.name] = _mark(row, checks, short, by_key)
             entry = {"law": law.name, "case": case.name, "verdict": row["verdict"]}
             if row["error_class"]:
                 tidy.append({**entry, "status": "error", "error": failure(row)})
@@ -121,10 +136,13 @@ def build(ctx: Context) -> Section:
     key = ", ".join(f"{s} = {c}" for c, s in short.items())
     sizes = ", ".join(f"{s:g}" for s in study.settings.get("continuity_sizes", ()))
     caption = (
-        "Every law on every scene at the scene's default parameters, one mark per check; the "
-        f"key: {key}; continuity perturbed at sizes {sizes}. A mark's colour is its verdict "
-        "(legend above); hover for the reason; a law property links to its finding. A single "
-        "mark is a law that gave no answer: refused (NotApplicable), a budget, or an error."
+        "Every law on every scene at the scene's default parameters, one mark per cell: the "
+        "worst verdict of its checks (unexplained, numerical failure, budget, law property, "
+        f"holds, refused, in that order), with the checks that have it; the key: {key}; "
+        f"continuity perturbed at sizes {sizes}. A mark's colour is its verdict (legend "
+        "above); hover for every check's verdict and reason; a law property links to its "
+        "finding. A law that gave no answer has its reason: refused (NotApplicable), a "
+        "budget, or an error. The CSV holds every check's verdict and value."
     )
     summary = (
         f"{len(data)} law-scene cells: {len(ran)} solved, {refused} refused by the law. "

@@ -2,7 +2,7 @@
 
 A view of the studies declared with ``view="sweep"``: the study's first axis (a grid parameter)
 is the abscissa, and each of the measures its other axes name (every measure when it names
-none) is drawn against it, one line per law, one panel per
+none) is drawn against it, one line per law and value of the other grid parameters, one panel per
 measure (a vector measure gives one panel per component); the table lists every cell with its
 verdict. An abscissa over two decades or more (a stiffness ratio) is drawn on a log scale.
 The abscissa takes the unit of the scene's parameter, each panel the unit the study
@@ -25,6 +25,7 @@ from lawbench.views.report.runs import Context, axis_value, parsed
 
 ANCHOR, TITLE, VIEWS = "sweeps", "Sweeps of the sources' systems", ("sweep",)
 PANELS_PER_ROW = 3
+DASHES = ("-", "--", ":", "-.")
 
 
 def build(ctx: Context) -> Section:
@@ -34,7 +35,8 @@ def build(ctx: Context) -> Section:
         "line per law, each measure on its own panel (the units are in the study's title)."
     ]
     for study, table in ctx.tables("sweep"):
-        frame = _tidy(table, study.axes[0], list(study.axes[1:]) or list(study.measures))
+        lines = [name for name in study.grid if name != study.axes[0]]
+        frame = _tidy(table, study.axes[0], list(study.axes[1:]) or list(study.measures), lines)
         if frame.empty:
             blocks.append(f"Study `{study.name}`: no law answered.")
             continue
@@ -47,13 +49,19 @@ def build(ctx: Context) -> Section:
     return Section(ANCHOR, TITLE, blocks)
 
 
-def _tidy(table: pd.DataFrame, axis: str, measures: list[str]) -> pd.DataFrame:
-    """One row per answered cell: law, the axis, each numeric measure (vectors expanded)."""
+def _tidy(table: pd.DataFrame, axis: str, measures: list[str], lines: list[str]) -> pd.DataFrame:
+    """One row per answered cell: law, the axis, each numeric measure (vectors expanded).
+
+    The other grid parameters ``lines`` join the law's name, so each of their values is a line
+    of its own (``lzb (mu=1)``).
+    """
     rows = []
     for row in table.fillna({"error_class": ""}).to_dict("records"):
         if row["error_class"]:
             continue
-        tidy: dict[str, Any] = {"law": row["law"], axis: axis_value(row, axis)}
+        values = ", ".join(f"{name}={axis_value(row, name):g}" for name in lines)
+        law = f"{row['law']} ({values})" if values else row["law"]
+        tidy: dict[str, Any] = {"law": law, axis: axis_value(row, axis)}
         for name in measures:
             value = parsed(row.get(name))
             if isinstance(value, list):
@@ -95,10 +103,15 @@ def _figure(
     rows = -(-len(columns) // PANELS_PER_ROW)
     fig, axes = plots.figure(rows, min(len(columns), PANELS_PER_ROW))
     units = units or {}
+    # A line named "law (mu=1)" takes its law's colour and a dash pattern of its own values.
+    variants = sorted({str(name).partition(" (")[2] for name in frame["law"]})
     for ax, column in zip(axes.flat, columns, strict=False):
         for law, group in frame.groupby("law", sort=True):
             ordered = group.sort_values(axis)
-            ax.plot(ordered[axis], ordered[column], **plots.law_style(str(law)))
+            base, _, values = str(law).partition(" (")
+            style = {**plots.law_style(base), "label": str(law)}
+            style["linestyle"] = DASHES[variants.index(values) % len(DASHES)]
+            ax.plot(ordered[axis], ordered[column], **style)
         if _decades(frame[axis]) >= 2:
             ax.set_xscale("log")
         ax.set_xlabel(unit_label(axis, units))
