@@ -21,10 +21,13 @@ their integration are in `lawbench.laws.jia.dynamics`.
   same stiffness increase at each of its ends of compression; a contact whose spring empties
   leaves the active set, and returns when its gap rate turns negative (no stiffness change on
   either event). The outcome depends on stiffness ratios only, taken from the contacts'
-  ``stiffness``; the springs are linear, the contacts' ``exponent`` is not read. The law treats
-  frictionless chains of balls on a line (the ball on a ball on the ground of the paper, the
-  two-ball wall scene, ball chains) and refuses other problems with several contacts. No time
-  passes within the impact: a reactivated contact ignores the gap it opened, so where a
+  ``stiffness``; the springs are linear, the contacts' ``exponent`` is not read. The paper
+  states it for chains of balls (a ball on a ball on the ground); the equations need only the
+  Delassus matrix, which couples the contacts of any system. With friction (the talk's part
+  III, simultaneous impacts with friction and compliance: the cue, the billiard ball and the
+  table) every frictional contact also carries its own tangential springs, driven by its own
+  normal impulse as at one contact: "the two normal impulses take turns to drive the system".
+  No time passes within the impact: a reactivated contact ignores the gap it opened, so where a
   contact opens and closes again the outcome differs from the same springs integrated in time.
 - Both: the stiffness rises at every end of compression, a second one after a return from
   restitution to compression included (the talk: "every end of compression of single
@@ -44,13 +47,14 @@ contact included), the closed form ``Pn = -(1 + e) un- / G_jj`` (the energetic c
 equals Newton's there); otherwise the spring equations integrated with scipy's DOP853 at the
 relative ``tol``, every transition (end of compression, slip, stick, separation,
 reactivation, lock, release) an event; a gap rate above ``-100 tol |u-|`` (at most 1 % of
-``|u-|``) does not count as approaching. Diagnostics: ``sequence`` (one contact: the modes and events, for
-example slip, stick, end of compression, slip, end of impact; several: the active sets),
+``|u-|``) does not count as approaching. Diagnostics: ``sequence`` (one contact: the modes
+and events, for example slip, stick, end of compression, slip, end of impact; several: the
+active sets),
 ``events`` (each transition with its ``tau`` and normal impulses), ``steps`` (integrator
 steps), ``compression_loss`` (J, energy taken at the ends of compression), ``recompressed``
 (contacts that separated and were compressed again). Option ``path``
-returns the impulse curve: ``tau``, ``Pn`` (k, m), ``Pt`` (k, d), ``En`` (k, m) and ``Et`` (k,)
-the spring energies (J), ``un`` and ``ut`` the contact velocities.
+returns the impulse curve: ``tau``, ``Pn`` (k, m), ``Pt`` (k, m d), ``En`` (k, m) and ``Et``
+(k, m) the spring energies (J), ``un`` and ``ut`` the contact velocities.
 """
 
 from __future__ import annotations
@@ -61,7 +65,6 @@ import numpy as np
 
 from lawbench.checks.declared import STUDIES, impact_path
 from lawbench.checks.regions import nonlinear_springs
-from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import is_diagonal
 from lawbench.core.outcome import Outcome
@@ -87,8 +90,8 @@ class Jia(Law):
 
     name = "jia"
     summary = (
-        "Jia's energy-based tangential compliance at one contact; Jia-Mason-Erdmann state "
-        "transitions for frictionless chains"
+        "Jia's energy-based tangential compliance at every frictional contact; "
+        "Jia-Mason-Erdmann state transitions for several contacts"
     )
     source = (
         "Jia, IJRR 32(1) 2013 (tangential compliance); Jia, Mason and Erdmann, IJRR 32(1) 2013 "
@@ -152,8 +155,6 @@ class Jia(Law):
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
-        if problem.m > 1:
-            _check_chain(problem)
         d = problem.d if problem.frictional else 0
         un = problem.un
         if not (un < -APPROACH * np.abs(np.concatenate([un, problem.ut])).max()).any():
@@ -169,12 +170,12 @@ class Jia(Law):
 
 
 def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str, Any]) -> Outcome:
-    """Integrate Jia's springs; ``d`` tangential directions at the single contact (0: none)."""
+    """Integrate Jia's springs; ``d`` tangential directions per contact (0: frictionless)."""
     m = problem.m
-    contact = problem.contacts[0]
-    eta0_sq = contact.tangential_ratio
+    eta0_sq = np.array([c.tangential_ratio for c in problem.contacts])
     stiffness = np.array([c.stiffness for c in problem.contacts])
-    springs = Springs(stiffness / stiffness[0], e, contact.mu if d else 0.0, eta0_sq)
+    mu = problem.mu if d else np.zeros(m)
+    springs = Springs(stiffness / stiffness[0], e, mu, eta0_sq)
     if d:
         G, u_minus = problem.contact_delassus, np.concatenate([problem.un, problem.ut])
     else:
@@ -182,8 +183,12 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
     impact = SpringImpact(G, u_minus, springs, options["tol"], options["path"])
     state = impact.run()
     record = impact.record
-    if d:
+    if d and m == 1:
         formulation = "tangential compliance, one contact (Jia 2013), integrated"
+    elif d:
+        formulation = (
+            "tangential compliance at every contact, state transitions (Jia 2012), integrated"
+        )
     elif m == 1:
         formulation = "normal spring, one contact (Jia 2013), integrated"
     else:
@@ -197,11 +202,11 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
         "recompressed": sorted(int(j) for j in record.recompressed),
     }
     if d:
-        diagnostics["tangential_stiffness_ratio"] = eta0_sq
+        diagnostics["tangential_stiffness_ratio"] = eta0_sq[0] if m == 1 else eta0_sq.tolist()
     if any(c.exponent != 1 for c in problem.contacts) and m > 1:
         diagnostics["springs"] = "linear: the contacts' exponent is not read"
     path = _path(impact, eta0_sq) if options["path"] else None
-    Pt = state[2 * m : 2 * m + d] if d else None
+    Pt = state[impact.It] if d else None
     Pn = state[:m]
     if not d:
         # A contact left approaching slower than the reactivation threshold (100 tol, at most
@@ -216,45 +221,22 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
     return Outcome.from_impulses(problem, Pn, Pt, diagnostics=diagnostics, path=path)
 
 
-def _path(impact: SpringImpact, eta0_sq: float) -> dict[str, np.ndarray]:
+def _path(impact: SpringImpact, eta0_sq: np.ndarray) -> dict[str, np.ndarray]:
     """The impulse curve from the samples of ``impact``: impulses, energies, velocities."""
     m, d = impact.m, impact.d
     samples = np.array(impact.record.samples)
     states = samples[:, 1:]
     velocities = np.array([impact.velocity(s) for s in states])
+    g = states[:, impact.g].reshape(len(states), m, d)
     return {
         "tau": samples[:, 0],
         "Pn": states[:, :m],
-        "Pt": states[:, 2 * m : 2 * m + d],
+        "Pt": states[:, impact.It],
         "En": states[:, m : 2 * m] ** 2,
-        "Et": np.sum(states[:, 2 * m + d :] ** 2, axis=1) / (4 * eta0_sq),
+        "Et": np.sum(g**2, axis=2) * impact.kappa0 / (4 * eta0_sq),
         "un": velocities[:, :m],
         "ut": velocities[:, m:],
     }
-
-
-def _check_chain(problem: ImpactProblem) -> None:
-    """Raise `NotApplicable` unless the problem is a frictionless chain of balls on a line."""
-    reason = None
-    if problem.frictional:
-        reason = "it has friction, and the state-transition model is frictionless"
-    elif np.any(problem.M - np.diag(np.diag(problem.M))):
-        reason = "its mass matrix is not diagonal (not balls on a line)"
-    else:
-        for j, column in enumerate(problem.Wn.T):
-            entries = column[column != 0]
-            if not (
-                len(entries) in (1, 2)
-                and np.all(np.abs(entries) == 1)
-                and (len(entries) == 1 or entries.sum() == 0)
-            ):
-                reason = f"contact {j} does not join two balls on a line, or a ball and a wall"
-                break
-    if reason:
-        raise NotApplicable(
-            "jia: with several contacts the law is Jia, Mason and Erdmann's state-transition "
-            f"model of frictionless chains of balls (a ball on a ball on the ground); here {reason}"
-        )
 
 
 LAWS.register(Jia())

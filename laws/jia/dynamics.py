@@ -1,4 +1,4 @@
-"""Impulse dynamics of Jia's compliant contacts: normal springs, one tangential spring.
+"""Impulse dynamics of Jia's compliant contacts: normal springs, tangential springs.
 
 Normal springs (Jia, Mason and Erdmann 2013; Jia 2013): contact i is a linear spring
 of stiffness ``k_i`` whose strain energy ``E_i`` changes with its normal impulse ``I_i`` as
@@ -27,29 +27,33 @@ reactivation can change the answer discontinuously with the tolerance (on random
 10 to 20 balls with e uniform in (0, 1), answers at tolerances 1e-10 to 1e-12 differed by up
 to 2 % of the largest velocity on some chains and by less than 1e-8 on others).
 
-Tangential spring (Jia 2013), at a single contact only: a massless particle
-joined to the body by the normal spring and by tangential springs of stiffness ``k'``, with
-``eta0^2 = k_0 / k'`` (``k_0`` the normal stiffness in compression). Writing ``s`` for the
-stretch of the tangential springs, ``F_t = -k' s``. The particle sticks (``ds/dt = ut``) while
-the tangential strain energy ``E_t = k' |s|^2 / 2`` stays below ``mu^2 eta^2 E_n``
-(``eta^2 = k / k'``, k the current normal stiffness), which is Coulomb's ``|F_t| <= mu F_n``;
-otherwise it slips with ``|F_t| = mu F_n`` and ``s`` along the slip velocity ``ut - ds/dt``.
-Slip turns to stick when the slip velocity vanishes, stick to slip when ``E_t`` reaches the
-bound. At the start the contact slips when ``|ut-| > mu eta0^2 |un-|`` (the talk's appendix 1).
-The springs hold no energy at the end (the bound vanishes with ``E_n``), except after a plastic
-end of compression, where what the tangential springs hold is lost with the impact's end.
+Tangential springs (Jia 2013; at several contacts at once, Jia's talk of 2012, part III): at
+each frictional contact a massless particle joined to the body by the normal spring and by
+tangential springs of stiffness ``k'``, with ``eta0^2 = k_0 / k'`` (``k_0`` the contact's normal
+stiffness in compression). Writing ``s`` for the stretch of the tangential springs,
+``F_t = -k' s``. The particle sticks (``ds/dt = ut``) while the tangential strain energy
+``E_t = k' |s|^2 / 2`` stays below ``mu^2 eta^2 E_n`` (``eta^2 = k / k'``, k the current normal
+stiffness), which is Coulomb's ``|F_t| <= mu F_n``; otherwise it slips with ``|F_t| = mu F_n``
+and ``s`` along the slip velocity ``ut - ds/dt``. Slip turns to stick when the slip velocity
+vanishes, stick to slip when ``E_t`` reaches the bound. A contact starts (or, reactivated,
+starts again) slipping when ``|ut| > mu eta0^2 |un|`` (the talk's appendix 1). The springs hold
+no energy at the end (the bound vanishes with ``E_n``); a contact that separates releases its
+tangential spring. After a plastic end of compression at a single contact, what its tangential
+springs hold is lost with the impact's end. With friction at several contacts a contact that
+turns rigid (e = 0, or the lock below) is not treated: the lock holds normal gap rates only.
 
 Jia writes these equations in the normal impulse; they are 0/0 where ``E_n`` vanishes, at the
 start and at the end. They are integrated here along ``tau = sqrt(2 k_ref) t``, with
-``y_i = sqrt(E_i)``, ``kappa_i = k_i / k_ref`` and ``g = sqrt(2 k_0) s`` (Jia's G), where they
-are regular (multiplied by ``dI_n/dtau``)::
+``y_i = sqrt(E_i)``, ``kappa_i = k_i / k_ref`` (``kappa0_i`` in compression) and
+``g_i = sqrt(2 k_ref) s_i`` (Jia's G), where they are regular (multiplied by ``dI_n/dtau``)::
 
     dI_i/dtau = sqrt(kappa_i) y_i          dy_i/dtau = -sqrt(kappa_i) u_i / 2
-    stick: dI_t/dtau = -g / (2 eta0^2)     dg/dtau = ut
-    slip:  dI_t/dtau = -mu dI_n/dtau ghat  dg/dtau = rho ghat + ut - (ut . ghat) ghat
+    stick: dI_t/dtau = -kappa0 g / (2 eta0^2)   dg/dtau = ut
+    slip:  dI_t/dtau = -mu dI_n/dtau ghat       dg/dtau = rho ghat + ut - (ut . ghat) ghat
 
-with ``rho = -mu kappa eta0^2 un`` (the rate of ``|g|`` that keeps ``|F_t| = mu F_n``),
-``E_t = |g|^2 / (4 eta0^2)`` and the stick bound ``|g| <= 2 mu eta0^2 sqrt(kappa) y``. Every
+with ``rho = -mu eta0^2 kappa un / kappa0`` (the rate of ``|g|`` that keeps
+``|F_t| = mu F_n``), ``E_t = kappa0 |g|^2 / (4 eta0^2)`` and the stick bound
+``|g| <= 2 mu eta0^2 sqrt(kappa) y / kappa0``, each per contact. Every
 transition is an event of the shared event integrator (`lawbench.numerics.integrator`, DOP853); the
 contact velocity is affine in the impulses, ``u = u- + G [I_n, I_t]`` with ``G`` the contact
 Delassus matrix.
@@ -63,7 +67,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lawbench.core.errors import SolverFailure
+from lawbench.core.errors import NotApplicable, SolverFailure
 from lawbench.core.mechanics import for_products
 from lawbench.numerics.integrator import EventIntegrator
 
@@ -88,16 +92,16 @@ class Springs:
         Normal stiffness of each contact over a common reference (only ratios matter).
     e : array (m,)
         Energetic restitution coefficients.
-    mu : float
-        Coulomb coefficient of the single contact with a tangential spring (0: none).
-    eta0_sq : float
-        Jia's ratio ``eta0^2`` of normal (compression) to tangential stiffness.
+    mu : array (m,)
+        Coulomb coefficients (0: no tangential spring acts).
+    eta0_sq : array (m,)
+        Jia's ratios ``eta0^2`` of normal (compression) to tangential stiffness.
     """
 
     kappa: np.ndarray
     e: np.ndarray
-    mu: float = 0.0
-    eta0_sq: float = 1.0
+    mu: np.ndarray
+    eta0_sq: np.ndarray
 
 
 @dataclass
@@ -118,9 +122,9 @@ class SpringImpact:
 
     Parameters
     ----------
-    G : array (m + d, m + d)
-        Contact Delassus matrix, the m normal rows first, then the d tangential rows of the
-        single contact with a tangential spring (d = 0: frictionless).
+    G : array (m + m d, m + m d)
+        Contact Delassus matrix, the m normal rows first, then d tangential rows per contact
+        (d = 0: frictionless).
     u_minus : array (m + d,)
         Pre-impact contact velocities.
     springs : Springs
@@ -143,9 +147,15 @@ class SpringImpact:
         # Products with G at every stage: banded (sparse) for a long chain.
         self.G_products = for_products(G)
         self.m = len(springs.kappa)
-        self.d = G.shape[0] - self.m
+        self.nt = G.shape[0] - self.m
+        self.d = self.nt // self.m
         self.tolerance, self.keep_path = tolerance, keep_path
         self.kappa = springs.kappa.astype(float).copy()
+        self.kappa0 = self.kappa.copy()
+        self.rough = (springs.mu > 0) & (self.d > 0)
+        # State layout: normal impulses, sqrt(E_n), tangential impulses, Jia's g.
+        self.It = slice(2 * self.m, 2 * self.m + self.nt)
+        self.g = slice(2 * self.m + self.nt, 2 * self.m + 2 * self.nt)
         threshold = min(max(ROUNDING, 100 * tolerance), NOT_APPROACHING)
         self.approach = threshold * float(np.abs(u_minus).max())
         self.active = u_minus[: self.m] < -self.approach
@@ -157,14 +167,10 @@ class SpringImpact:
         self.floor = np.full(self.m, -self.approach)
         self.lock = np.zeros((0, self.m))
         self.record = Record()
-        self.stick = True
-        self.direction = np.zeros(self.d)
-        if self.d:
-            ut, un = u_minus[self.m :], u_minus[0]
-            # The contact starts slipping when |ut| > mu eta0^2 |un| (talk, appendix 1).
-            if np.linalg.norm(ut) > springs.mu * springs.eta0_sq * self.kappa[0] * -un:
-                self.stick = False
-                self.direction = ut / np.linalg.norm(ut)
+        self.stick = np.ones(self.m, dtype=bool)
+        self.direction = np.zeros((self.m, self.d))
+        for j in np.flatnonzero(self.active & self.rough):
+            self._start_friction(j, u_minus)
         diag = np.diag(G)[: self.m] * self.kappa
         frequency = math.sqrt(float(diag.min()) / 2.0)
         self.time_scale = 2.0 * math.pi / frequency
@@ -180,8 +186,8 @@ class SpringImpact:
             [
                 np.full(self.m, impulse),
                 np.full(self.m, math.sqrt(impulse * approach)),
-                np.full(self.d, impulse),
-                np.full(self.d, rate * self.time_scale),
+                np.full(self.nt, impulse),
+                np.full(self.nt, rate * self.time_scale),
             ]
         )
 
@@ -189,32 +195,52 @@ class SpringImpact:
 
     def velocity(self, s: np.ndarray) -> np.ndarray:
         """Contact velocities at state ``s``."""
-        impulses = np.concatenate([s[: self.m], s[2 * self.m : 2 * self.m + self.d]])
+        impulses = np.concatenate([s[: self.m], s[self.It]])
         return self.u_minus + self.G_products @ impulses
 
-    def _ghat(self, g: np.ndarray) -> np.ndarray:
+    def _tangential(self, x: np.ndarray, j: int) -> np.ndarray:
+        """Contact j's block of a tangential part (``d`` entries) of ``x``."""
+        return x[j * self.d : (j + 1) * self.d]
+
+    def _ghat(self, j: int, g: np.ndarray) -> np.ndarray:
         norm = np.linalg.norm(g)
-        return g / norm if norm > 0 else self.direction
+        return g / norm if norm > 0 else self.direction[j]
+
+    def _start_friction(self, j: int, u: np.ndarray) -> None:
+        """Stick or slip as contact j starts: slip when ``|ut| > mu eta0^2 |un|``."""
+        springs = self.springs
+        ut = self._tangential(u[self.m :], j)
+        speed = float(np.linalg.norm(ut))
+        self.stick[j] = speed <= springs.mu[j] * springs.eta0_sq[j] * -u[j]
+        if not self.stick[j]:
+            self.direction[j] = ut / speed
+
+    def _rho(self, j: int, u: np.ndarray) -> float:
+        """Rate of ``|g_j|`` that keeps contact j's spring force at ``mu F_n`` while it slips."""
+        springs = self.springs
+        return -springs.mu[j] * springs.eta0_sq[j] * self.kappa[j] * u[j] / self.kappa0[j]
 
     def _rate(self, tau: float, s: np.ndarray) -> np.ndarray:
-        m, d, springs = self.m, self.d, self.springs
+        m, springs = self.m, self.springs
         u = self.velocity(s)
         root = np.sqrt(self.kappa) * self.active
-        rate = np.empty_like(s)
+        rate = np.zeros_like(s)
         rate[:m] = root * s[m : 2 * m]
         rate[m : 2 * m] = -root * u[:m] / 2.0
         if self.locked.any():
             rate[:m][self.locked] = self.lock @ rate[:m]
-        if d:
-            g, ut = s[2 * m + d :], u[m:]
-            if self.stick:
-                rate[2 * m : 2 * m + d] = -g / (2.0 * springs.eta0_sq)
-                rate[2 * m + d :] = ut
+        impulse_rate, g_rate = rate[self.It], rate[self.g]
+        g_all, ut_all = s[self.g], u[m:]
+        for j in np.flatnonzero(self.active & self.rough):
+            g, ut = self._tangential(g_all, j), self._tangential(ut_all, j)
+            rows = slice(j * self.d, (j + 1) * self.d)
+            if self.stick[j]:
+                impulse_rate[rows] = -self.kappa0[j] * g / (2.0 * springs.eta0_sq[j])
+                g_rate[rows] = ut
             else:
-                ghat = self._ghat(g)
-                rho = -springs.mu * self.kappa[0] * springs.eta0_sq * u[0]
-                rate[2 * m : 2 * m + d] = -springs.mu * rate[0] * ghat
-                rate[2 * m + d :] = rho * ghat + ut - (ut @ ghat) * ghat
+                ghat = self._ghat(j, g)
+                impulse_rate[rows] = -springs.mu[j] * rate[j] * ghat
+                g_rate[rows] = self._rho(j, u) * ghat + ut - (ut @ ghat) * ghat
         return rate
 
     def _lock_map(self) -> np.ndarray:
@@ -231,17 +257,16 @@ class SpringImpact:
     def _spring_rate(self, s: np.ndarray) -> np.ndarray:
         return np.sqrt(self.kappa) * self.active * s[self.m : 2 * self.m]
 
-    def _stick_margin(self, s: np.ndarray) -> float:
-        """``|g|`` minus the stick bound: positive once the spring force exceeds mu F_n."""
-        m, springs = self.m, self.springs
-        bound = 2.0 * springs.mu * springs.eta0_sq * math.sqrt(self.kappa[0]) * s[m]
-        return float(np.linalg.norm(s[2 * m + self.d :])) - bound
-
-    def _slip_speed(self, s: np.ndarray, u: np.ndarray) -> float:
-        """Slip velocity along the spring: ``ut . ghat - d|g|/dtau``; zero when slip stops."""
-        ghat = self._ghat(s[2 * self.m + self.d :])
+    def _stick_margin(self, j: int, s: np.ndarray) -> float:
+        """``|g_j|`` minus its stick bound: positive once the spring force exceeds mu F_n."""
         springs = self.springs
-        return float(u[self.m :] @ ghat) + springs.mu * self.kappa[0] * springs.eta0_sq * u[0]
+        bound = 2.0 * springs.mu[j] * springs.eta0_sq[j] * math.sqrt(self.kappa[j]) * s[self.m + j]
+        return float(np.linalg.norm(self._tangential(s[self.g], j))) - bound / self.kappa0[j]
+
+    def _slip_speed(self, j: int, s: np.ndarray, u: np.ndarray) -> float:
+        """Slip velocity along the spring: ``ut . ghat - d|g|/dtau``; zero when slip stops."""
+        ghat = self._ghat(j, self._tangential(s[self.g], j))
+        return float(self._tangential(u[self.m :], j) @ ghat) - self._rho(j, u)
 
     def _events(self) -> list[tuple[str, int, int]]:
         """The armed events ``(name, contact, direction)``.
@@ -259,8 +284,8 @@ class SpringImpact:
             else:
                 armed.append(("recompression", j, -1))
                 armed.append(("separation", j, -1))
-        if self.d and self.active[0]:
-            armed.append(("slip", 0, 1) if self.stick else ("stick", 0, -1))
+        for j in np.flatnonzero(self.active & self.rough):
+            armed.append(("slip", j, 1) if self.stick[j] else ("stick", j, -1))
         return armed
 
     def _event_functions(
@@ -294,10 +319,10 @@ class SpringImpact:
             out[springs] = s[spring_of]
             if releases.size:
                 out[releases] = self.lock[release_rows] @ self._spring_rate(s)
-            if slip.size:
-                out[slip] = self._stick_margin(s)
-            if stick.size:
-                out[stick] = self._slip_speed(s, u)
+            for i in slip:
+                out[i] = self._stick_margin(int(contacts[i]), s)
+            for i in stick:
+                out[i] = self._slip_speed(int(contacts[i]), s, u)
             return out
 
         return values
@@ -316,8 +341,8 @@ class SpringImpact:
             self.tolerance * self.scale,
             past=False,
         )
-        tau, s = 0.0, np.zeros(2 * (self.m + self.d))
-        self._note_state(tau, s, ["stick" if self.stick else "slip"] if self.d else [])
+        tau, s = 0.0, np.zeros(2 * (self.m + self.nt))
+        self._note_state(tau, s, ["stick" if self.stick[0] else "slip"] if self.nt else [])
         while True:
             s = self._settle(s)
             if not self.active.any():
@@ -394,6 +419,12 @@ class SpringImpact:
                 self.kappa[j] /= e * e
             stiff = self._stiffest_ratio(j) > LOCK
             negligible = y * y <= self.tolerance * self.scale[m] ** 2
+            if (e == 0 or stiff) and self.rough.any() and m > 1:
+                raise NotApplicable(
+                    f"jia: contact {j} turns rigid (e = 0, or {LOCK:g} times stiffer than the "
+                    "softest other loaded spring) with friction at several contacts; the rigid "
+                    "lock holds normal gap rates only"
+                )
             if e == 0 or (stiff and negligible):
                 self.record.compression_loss += float(y * y)
                 self.active[j], self.rigid[j], self.locked[j], s[m + j] = False, True, True, 0.0
@@ -416,6 +447,8 @@ class SpringImpact:
             self.compressing[j] = True
         elif name == "separation":
             self.active[j], self.compressing[j], s[m + j] = False, False, 0.0
+            # The contact releases its tangential spring.
+            self._tangential(s[self.g], j)[:] = 0.0
             self.record.released.add(j)
         elif name == "release":
             self.record.released.add(j)
@@ -430,17 +463,19 @@ class SpringImpact:
                 self.locked[j] = True
             else:
                 self.active[j], self.compressing[j] = True, True
+                if self.rough[j]:
+                    self._start_friction(j, self.velocity(s))
         elif name == "slip":
-            self.stick = False
-            self.direction = self._ghat(s[2 * m + self.d :])
+            self.stick[j] = False
+            self.direction[j] = self._ghat(j, self._tangential(s[self.g], j))
         else:
-            self.stick = True
+            self.stick[j] = True
         return s
 
     def _note_state(self, tau: float, s: np.ndarray, fired: list[str]) -> None:
         """Record the events at ``tau`` and the state (several contacts) or mode that follows."""
         self.record.events.append({"tau": tau, "events": fired, "Pn": s[: self.m].tolist()})
-        if self.m > 1 or not self.d:
+        if self.m > 1 or not self.nt:
             active = [str(j) for j in np.flatnonzero(self.active)]
             active += [f"{j} locked" for j in np.flatnonzero(self.locked)]
             labels = ["{" + ", ".join(active) + "}" if self.active.any() else "end of impact"]
