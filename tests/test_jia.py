@@ -423,7 +423,7 @@ def test_path_fields():
 def test_a_rigid_contact_among_several_frictional_ones_is_refused_with_the_reason():
     """With friction at several contacts, a contact that turns rigid (e = 0: the rocking
     block's plastic landing) would need a lock of its tangential springs too: refused."""
-    with pytest.raises(lawbench.NotApplicable, match="turns rigid .* friction at several"):
+    with pytest.raises(lawbench.NotApplicable, match=r"turns rigid .* friction at several"):
         LAW.resolve(lawbench.CASES.get("rocking_block").build())
 
 
