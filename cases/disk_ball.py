@@ -241,10 +241,12 @@ STUDIES.register(
 STUDIES.register(
     impact_paths(
         "disk_ball_energies",
-        "disk struck low, at the centre and high (b = -4.5, 0, 4.5 cm): the energetic law's "
-        "stored energy per contact along the impact (contacts 0-2 the floor points A, B, C; "
-        "3 the ball D) and its primary contacts",
-        "lzb",
+        "disk struck low, at the centre and high (b = -4.5, 0, 4.5 cm): the stored energy per "
+        "contact along the impact (contacts 0-2 the floor points A, B, C; 3 the ball D), of "
+        "the energetic law (Zhang et al. 2013, its central figure) against its impulse-time "
+        "variable, and of the compliant ground truth against time; the energetic law's "
+        "primary contacts",
+        ("lzb", "compliant"),
         "disk_ball",
         "b",
         [-0.045, 0.0, 0.045],

@@ -466,10 +466,12 @@ def test_the_quick_stability_grid_has_no_nan_and_no_time_out(quick):
 
 
 def test_a_path_study_along_a_parameter_draws_each_cell_side_by_side():
-    """disk_ball_energies: the energetic law's stored energy per contact (J) against time (s)
-    at three impact heights, one panel per height on a shared energy axis; the energy of a
-    contact is never negative and ends at zero (every spring relaxes when the impact ends);
-    struck high, the primary contact passes from the ball D to the floor's far point C."""
+    """disk_ball_energies, the central figure of Zhang et al. 2013: the stored energy per
+    contact (J) at three impact heights, one panel per height on a shared energy axis, a row
+    for the energetic law (against its impulse-time variable) and a row for the compliant
+    ground truth (against time). A contact's energy is never negative and ends at zero (every
+    spring relaxes when the impact ends); struck high, lzb's primary contact passes from the
+    ball D to the floor's far point C."""
     from lawbench.studies.runner import Executor, collect
     from lawbench.views.report.inside import _along
 
@@ -478,13 +480,16 @@ def test_a_path_study_along_a_parameter_draws_each_cell_side_by_side():
         table = collect(study.plan(), pool)
     drawn = _along(lawbench.CASES.get("disk_ball"), study, table)
     shown = [ax for ax in drawn.figure.axes if ax.get_visible()]
-    assert [ax.get_title() for ax in shown] == ["b = -0.045 m", "b = 0 m", "b = 0.045 m"]
+    assert [ax.get_title() for ax in shown] == [
+        f"{law}, b = {b} m" for law in ("lzb", "compliant") for b in ("-0.045", "0", "0.045")
+    ]
     assert {ax.get_ylabel() for ax in shown} == {"stored energy [J]"}
-    assert {ax.get_xlabel() for ax in shown} == {"time [s]"}
-    assert "b = 0.045 m: stored_energy_peaks = [" in drawn.caption
+    assert [ax.get_xlabel() for ax in shown[3:]] == ["time [s]"] * 3
+    assert "lzb, b = 0.045 m: stored_energy_peaks = [" in drawn.caption
     assert "primary_contacts = [3, 2]" in drawn.caption
     data = drawn.data
+    assert set(data["law"]) == {"lzb", "compliant"}
     assert set(data["component"]) == {f"contact {j}" for j in range(4)}
-    assert (data["value"] >= 0).all()
-    for _, group in data.groupby(["b", "component"]):
+    assert (data["value"] >= -1e-12 * data["value"].max()).all()
+    for _, group in data.groupby(["law", "b", "component"]):
         assert group["value"].iloc[-1] <= 1e-9 * data["value"].max()

@@ -223,25 +223,25 @@ def impact_path(law: str, case: str, title: str, params: Mapping[str, Any] | Non
 def impact_paths(
     name: str,
     title: str,
-    law: str,
+    laws: tuple[str, ...],
     case: str,
     axis: str,
     values: Sequence[Any],
     quantities: Sequence[str],
     extra: Mapping[str, Measure] | None = None,
 ) -> Study:
-    """``law`` on ``case`` at each of ``values`` of the parameter ``axis`` (option ``path``).
+    """Each of ``laws`` on ``case`` at each of ``values`` of the parameter ``axis`` (``path``).
 
     The report draws the path's ``quantities`` (keys of `lawbench.core.outcome.Outcome.path`) of
-    every cell side by side; ``extra`` measures join the table.
+    every cell side by side, one row of panels per law; ``extra`` measures join the table.
     """
     return Study(
         name=name,
         title=title,
         cases=(case,),
-        laws=(law,),
+        laws=tuple(laws),
         grid={axis: list(values)},
-        options={law: {"path": [True]}},
+        options={law: {"path": [True]} for law in laws},
         measures={"path": measures.impact_path, **dict(extra or {})},
         checks=("energy_gain",),
         axes=(axis, *quantities),

@@ -133,21 +133,27 @@ def _figure(case: Case, what: str, row: dict[str, Any], found: dict[str, Any]) -
 
 
 def _along(case: Case, study: Study, table: pd.DataFrame) -> Figure:
-    """The quantities ``study.axes[1:]`` of each cell's path, one column of panels per cell."""
+    """The quantities ``study.axes[1:]`` of each cell's path, side by side.
+
+    A column of panels per value of the study's parameter, a row per law and quantity.
+    """
     axis, quantities = study.axes[0], list(study.axes[1:])
     rows = table.fillna({"error_class": ""}).to_dict("records")
-    rows.sort(key=lambda row: axis_value(row, axis))
+    laws = list(dict.fromkeys(row["law"] for row in rows))
+    values = sorted({axis_value(row, axis) for row in rows})
     unit = {spec.name: spec.unit for spec in case.params}.get(axis, "")
-    fig, axes = plots.figure(len(quantities), len(rows), width=3.6, height=2.8)
+    fig, axes = plots.figure(len(laws) * len(quantities), len(values), width=3.6, height=2.8)
     data, notes = [], []
-    for col, row in enumerate(rows):
+    for row in sorted(rows, key=lambda row: (laws.index(row["law"]), axis_value(row, axis))):
         value = axis_value(row, axis)
-        heading = f"{axis} = {value:g} {unit}".rstrip()
+        col, law = values.index(value), row["law"]
+        block = laws.index(law) * len(quantities)
+        heading = f"{law}, {axis} = {value:g} {unit}".rstrip()
         found = None if row["error_class"] else parsed(row.get("path"))
         if not found:
             why = failure(row) if row["error_class"] else "the law returned no path"
             notes.append(f"{heading}: no path, {why}")
-            for ax in axes[:, col]:
+            for ax in axes[block : block + len(quantities), col]:
                 ax.set_axis_off()
             continue
         measured = _measured(row, [name for name in study.measures if name != "path"])
@@ -158,27 +164,26 @@ def _along(case: Case, study: Study, table: pd.DataFrame) -> Figure:
         x_name, x_unit = QUANTITIES.get(x_key, (x_key, "unit not stated"))
         x = np.asarray(path[x_key], dtype=float).reshape(-1)
         for line, key in enumerate(quantities):
-            ax = axes[line, col]
+            ax = axes[block + line, col]
             if col:
-                ax.sharey(axes[line, 0])
+                ax.sharey(axes[block + line, 0])
             name, key_unit = QUANTITIES.get(key, (key, "unit not stated"))
-            values = np.asarray(path.get(key, []), dtype=float).reshape(len(x), -1)
-            for j in range(min(values.shape[1], MAX_COMPONENTS)):
-                part = f"contact {j}" if values.shape[1] > 1 else key
-                ax.plot(x, values[:, j], label=part, linewidth=1.0)
+            series = np.asarray(path.get(key, []), dtype=float).reshape(len(x), -1)
+            for j in range(min(series.shape[1], MAX_COMPONENTS)):
+                part = f"contact {j}" if series.shape[1] > 1 else key
+                ax.plot(x, series[:, j], label=part, linewidth=1.0)
                 data.append(
                     pd.DataFrame(
-                        {axis: value, x_name: x, "quantity": name, "component": part}
-                        | {"value": values[:, j]}
+                        {"law": law, axis: value, x_name: x, "quantity": name}
+                        | {"component": part, "value": series[:, j]}
                     )
                 )
             ax.set(title=heading, xlabel=f"{x_name} [{x_unit}]", ylabel=f"{name} [{key_unit}]")
             ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 3))
-            _spread(ax, values)
-            if 1 < values.shape[1] <= 6:
+            _spread(ax, series)
+            if 1 < series.shape[1] <= 6:
                 ax.legend(fontsize="xx-small")
-    law = rows[0]["law"]
-    fig.suptitle(f"{law} on {case.name} along {axis}")
+    fig.suptitle(f"{', '.join(laws)} on {case.name} along {axis}")
     reproduce = "; ".join(f"`{row['reproducer']}`" for row in rows)
     caption = f"{study.title}. Reproduce: {reproduce}."
     if notes:
