@@ -57,6 +57,9 @@ TABLE_TANGENTS = (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
 GRAVITY = 9.81  # m/s^2
 # Relative size below which a vertical velocity or a slip counts as none.
 TOUCHING = 1e-9
+# The ball's path on the cloth after the shot: how long, how many points.
+PATH_SECONDS = 1.0
+PATH_POINTS = 101
 COORDINATES = ["u [m/s]"] + [f"v{a} [m/s]" for a in "xyz"] + [f"w{a} [rad/s]" for a in "xyz"]
 
 
@@ -238,6 +241,47 @@ def path_curvature(trial: Trial) -> float | None:
     return float((v[0] * a[1] - v[1] * a[0]) / speed**3)
 
 
+def table_path(trial: Trial) -> dict[str, Any] | None:
+    """The ball's path on the cloth after the shot (m): hop, sliding, then rolling, for 1 s.
+
+    A ball struck down into the table leaves it at ``vz > 0``: it flies for ``2 vz / g`` at its
+    horizontal velocity and spin and lands keeping them (the landing's friction neglected).
+    On the cloth the slip of the contact point ``s = (vx - R wy, vy + R wx)`` keeps its
+    direction while the ball slides: friction ``mu2 m g`` against it accelerates the centre by
+    ``a = -mu2 g s0 / |s0|`` and reduces the slip at ``(7/2) mu2 g`` (a solid sphere; spin about
+    the vertical leaves the slip alone), so the path is a parabola, the masse curve, until
+    ``t_roll = 2 |s0| / (7 mu2 g)`` after landing, then a straight line at the rolling velocity
+    (rolling resistance neglected). None when the ball does not move on the table.
+    """
+    v, w = trial.outcome.v_plus[1:4], trial.outcome.v_plus[4:]
+    radius, mu = trial.params["radius"], trial.params["mu"][1]
+    if math.hypot(v[0], v[1]) == 0:
+        return None
+    flight = 2 * max(float(v[2]), 0.0) / GRAVITY
+    slip = np.array([v[0] - radius * w[1], v[1] + radius * w[0]])
+    size = float(np.linalg.norm(slip))
+    sliding = size > TOUCHING * float(np.linalg.norm(v)) and mu > 0
+    a = -mu * GRAVITY * slip / size if sliding else np.zeros(2)
+    rolling = 2 * size / (7 * mu * GRAVITY) if sliding else 0.0
+    t = np.linspace(0.0, PATH_SECONDS, PATH_POINTS)
+    on_cloth = np.maximum(t - flight, 0.0)
+    slid = np.minimum(on_cloth, rolling)[:, None]
+    rolled = (on_cloth - np.minimum(on_cloth, rolling))[:, None]
+    position = (
+        v[:2] * np.minimum(t, flight)[:, None]
+        + v[:2] * slid
+        + 0.5 * a * slid**2
+        + (v[:2] + a * rolling) * rolled
+    )
+    return {
+        "t": t.tolist(),
+        "x": position[:, 0].tolist(),
+        "y": position[:, 1].tolist(),
+        "t_land": flight,
+        "t_roll": flight + rolling,
+    }
+
+
 MEASURES = {
     "velocity": ball_velocity,
     "ball_speed": ball_speed,
@@ -282,6 +326,22 @@ STUDIES.register(
         axes=("offset_side",),
         units=UNITS,
         view="sweep",
+    )
+)
+STUDIES.register(
+    Study(
+        name="billiard_masse",
+        title="masse shot (elevation 70 degrees, offsets 12 mm sideways and 5 mm up): the ball's "
+        "path on the cloth (m) during its first second, sliding on a parabola until it rolls, "
+        "for every law that treats the shot, as the cue's compliance changes (stiffness of "
+        "the ball-table contact over the cue-ball one, 0.1 to 10: a soft tip to a hard one)",
+        cases=("billiard",),
+        grid={"stiffness_ratio": [0.1, 1.0, 10.0]},
+        params={"elevation": 70.0, "offset_side": 0.012, "offset_height": 0.005},
+        measures={"table_path": table_path, "curvature": path_curvature},
+        axes=("stiffness_ratio",),
+        units={"table_path": "m", "curvature": "1/m"},
+        view="table_path",
     )
 )
 STUDIES.register(speed_accuracy("billiard"))

@@ -98,3 +98,34 @@ def test_english_alone_runs_straight_and_a_masse_shot_curves():
     bent = curvature(**masse)
     assert abs(bent) > 0.1
     assert curvature(**{**masse, "offset_side": -masse["offset_side"]}) == pytest.approx(-bent)
+
+
+@pytest.mark.parametrize("law", ["moreau", "jia", "compliant"])
+def test_the_path_on_the_cloth_hops_slides_on_a_parabola_and_rolls(law):
+    """After the masse shot the ball hops for 2 vz / g, then slides: its acceleration is
+    -mu2 g along the initial slip, and it rolls from t_roll on at v0 - (2/7) s0 (a solid
+    sphere: the classical 5/7 of a spinless ball's speed), its path a straight line after the
+    parabola."""
+    from lawbench.cases.billiard import table_path
+    from lawbench.core.trial import Trial
+
+    params = CASE.parameters(**CASE.examples["masse"])
+    problem = CASE.build(**params)
+    outcome = lawbench.LAWS.get(law).resolve(problem)
+    trial = Trial(lawbench.LAWS.get(law), CASE, params, {}, problem, outcome, {})
+    path = table_path(trial)
+    v, w = outcome.v_plus[1:4], outcome.v_plus[4:]
+    radius, mu, g = params["radius"], params["mu"][1], 9.81
+    slip = np.array([v[0] - radius * w[1], v[1] + radius * w[0]])
+    assert path["t_land"] == pytest.approx(2 * max(v[2], 0.0) / g)
+    assert path["t_roll"] - path["t_land"] == pytest.approx(2 * np.linalg.norm(slip) / (7 * mu * g))
+    t, xy = np.array(path["t"]), np.column_stack([path["x"], path["y"]])
+    rolling = t > path["t_roll"] + 1e-9
+    speed = np.diff(xy[rolling], axis=0) / np.diff(t[rolling])[:, None]
+    np.testing.assert_allclose(speed, np.tile(v[:2] - 2 / 7 * slip, (len(speed), 1)), atol=1e-9)
+    sliding = (t > path["t_land"] + 1e-9) & (t < path["t_roll"] - 1e-9)
+    assert sliding.sum() >= 3
+    on_parabola = xy[sliding]
+    accel = (on_parabola[2:] - 2 * on_parabola[1:-1] + on_parabola[:-2]) / (t[1] - t[0]) ** 2
+    expected = -mu * g * slip / np.linalg.norm(slip)
+    np.testing.assert_allclose(accel, np.tile(expected, (len(accel), 1)), atol=1e-6)

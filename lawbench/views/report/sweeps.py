@@ -7,7 +7,9 @@ measure (a vector measure gives one panel per component); the table lists every 
 verdict. An abscissa over two decades or more (a stiffness ratio) is drawn on a log scale.
 The abscissa takes the unit of the scene's parameter, each panel the unit the study
 declares for its measure (``Study.units``): one panel holds one quantity, so quantities of
-different units (m/s, rad/s) never share an axis.
+different units (m/s, rad/s) never share an axis. A study declared with ``view="table_path"``
+draws each law's path of a ball on the table (its ``table_path`` measure, x and y in m) in one
+panel per value of its parameter.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from lawbench.views.report.page import Figure, Section, Table, number
 from lawbench.views.report.plots import unit_label
 from lawbench.views.report.runs import Context, axis_value, parsed
 
-ANCHOR, TITLE, VIEWS = "sweeps", "Sweeps of the sources' systems", ("sweep",)
+ANCHOR, TITLE, VIEWS = "sweeps", "Sweeps of the sources' systems", ("sweep", "table_path")
 PANELS_PER_ROW = 3
 DASHES = ("-", "--", ":", "-.")
 
@@ -46,7 +48,47 @@ def build(ctx: Context) -> Section:
         for column in shown.columns.drop(["law", "verdict"]):
             shown[column] = shown[column].map(number)
         blocks.append(Table(f"sweep_{study.name}", study.title, shown, data=frame))
+    for study, table in ctx.tables("table_path"):
+        blocks.append(_paths(study.name, study.title, table, study.axes[0]))
     return Section(ANCHOR, TITLE, blocks)
+
+
+def _paths(name: str, title: str, table: pd.DataFrame, axis: str) -> Figure:
+    """One panel per value of ``axis``: every law's ``table_path`` (x, y in m), equal scales.
+
+    Where a law's ball lands from its hop (a cross) and starts rolling (a dot) is marked.
+    """
+    rows = [r for r in table.fillna({"error_class": ""}).to_dict("records") if not r["error_class"]]
+    values = sorted({axis_value(row, axis) for row in rows})
+    fig, axes = plots.figure(1, max(len(values), 1), width=4.0, height=4.0)
+    data, missing = [], []
+    for row in rows:
+        path = parsed(row.get("table_path"))
+        value = axis_value(row, axis)
+        if not isinstance(path, dict):
+            missing.append(f"{row['law']} at {axis} = {value:g}")
+            continue
+        ax = axes[0, values.index(value)]
+        x, y = np.asarray(path["x"]), np.asarray(path["y"])
+        style = plots.law_style(row["law"])
+        ax.plot(x, y, color=style["color"], label=row["law"], linewidth=1.2)
+        for key, marker in (("t_land", "x"), ("t_roll", "o")):
+            k = int(np.searchsorted(path["t"], path[key]))
+            if 0 < k < len(x):
+                ax.plot(x[k], y[k], marker, color=style["color"], markersize=4)
+        data.append(pd.DataFrame({"law": row["law"], axis: value, "x": x, "y": y}))
+    for ax, value in zip(axes[0], values, strict=False):
+        ax.set(title=f"{axis} = {value:g}", xlabel="x [m]", ylabel="y [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.legend(fontsize="x-small")
+    caption = (
+        f"{title}. Each law's post-impact velocity and spin give the path in closed form: a "
+        "hop (landing marked by a cross), sliding on a parabola, rolling from the dot on."
+    )
+    if missing:
+        caption += " No path (the ball does not move on the table): " + ", ".join(missing) + "."
+    frame = pd.concat(data, ignore_index=True) if data else pd.DataFrame()
+    return Figure(f"sweep_{name}", caption, fig, frame)
 
 
 def _tidy(table: pd.DataFrame, axis: str, measures: list[str], lines: list[str]) -> pd.DataFrame:
