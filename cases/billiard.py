@@ -198,9 +198,9 @@ class Billiard(Case):
 CASES.register(Billiard())
 
 
-def ball_velocity(trial: Trial) -> list[float]:
+def ball_velocity(trial: Trial) -> dict[str, float]:
     """The velocity of the ball's centre after the shot (m/s, world frame)."""
-    return [float(v) for v in trial.outcome.v_plus[1:4]]
+    return dict(zip(("vx", "vy", "vz"), map(float, trial.outcome.v_plus[1:4]), strict=True))
 
 
 def ball_speed(trial: Trial) -> float:
@@ -208,9 +208,9 @@ def ball_speed(trial: Trial) -> float:
     return float(np.linalg.norm(trial.outcome.v_plus[1:4]))
 
 
-def spin(trial: Trial) -> list[float]:
+def spin(trial: Trial) -> dict[str, float]:
     """The ball's angular velocity after the shot (rad/s, world frame)."""
-    return [float(w) for w in trial.outcome.v_plus[4:]]
+    return dict(zip(("wx", "wy", "wz"), map(float, trial.outcome.v_plus[4:]), strict=True))
 
 
 def spin_axis_tilt(trial: Trial) -> float | None:

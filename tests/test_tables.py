@@ -263,18 +263,23 @@ def test_a_sweep_draws_each_measure_against_its_axis_per_law():
     frame = sweeps._tidy(table, "elevation", list(study.measures), [])
     assert set(frame["law"]) == {"moreau"}
     assert sorted(frame["elevation"]) == [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]
-    assert {"ball_speed", "spin[0]", "spin[2]", "spin_tilt"} <= set(frame.columns)
+    assert {"ball_speed", "spin[wx]", "spin[wz]", "spin_tilt"} <= set(frame.columns)
     units = {**study.units, "elevation": "deg"}
     figure = sweeps._figure("billiard", study.title, frame, "elevation", units)
     shown = [ax for ax in figure.figure.axes if ax.get_visible()]
-    velocity = [f"velocity[{k}]" for k in range(3)]
-    spin = [f"spin[{k}]" for k in range(3)]
+    # Each component is named as the captions name it; a component that is zero is drawn as 0.
+    velocity = [f"velocity[{k}]" for k in ("vx", "vy", "vz")]
+    spin = [f"spin[{k}]" for k in ("wx", "wy", "wz")]
     titles = [*velocity, "ball_speed", *spin, "spin_tilt", "curvature"]
     assert [ax.get_title() for ax in shown] == titles
     assert {ax.get_xlabel() for ax in shown} == {"elevation [deg]"}
     ylabels = [ax.get_ylabel() for ax in shown]
     assert ylabels[:4] == [f"{c} [m/s]" for c in [*velocity, "ball_speed"]]
     assert ylabels[4:] == [f"{c} [rad/s]" for c in spin] + ["spin_tilt [deg]", "curvature [1/m]"]
+    for ax in shown:
+        for line in ax.get_lines():
+            values = np.abs(line.get_ydata())
+            assert not ((values > 0) & (values < 1e-12 * max(values.max(), 1e-300))).any()
 
 
 def test_every_sweep_states_the_unit_of_what_it_draws():
@@ -304,3 +309,26 @@ def test_a_sweep_over_decades_draws_a_log_abscissa():
     shown = [ax for ax in figure.figure.axes if ax.get_visible()]
     assert {ax.get_xscale() for ax in shown} == {"log"}
     assert [ax.get_ylabel() for ax in shown] == ["v1_over_v0 [-]", "v2_over_v0 [-]"]
+
+
+def test_laws_with_the_same_answers_are_drawn_as_one_line_named_after_them_all():
+    """moreau and newton give the same answers along the axis: one line, 'moreau = newton',
+    never one hidden under the other; lzb differs by more than 1e-9 and keeps its own."""
+    import matplotlib.pyplot as plt
+
+    from lawbench.views.report import sweeps
+
+    axis = [0.1, 1.0, 10.0]
+    frame = pd.DataFrame(
+        {
+            "law": ["moreau"] * 3 + ["newton"] * 3 + ["lzb"] * 3,
+            "e": axis * 3,
+            "v": [1.0, 2.0, 3.0, 1.0, 2.0, 3.0, 1.0, 2.0, 3.0 + 1e-6],
+            "verdict": "holds",
+        }
+    )
+    assert sweeps.coinciding(frame, "e", ["v"]) == {"lzb": ["lzb"], "moreau": ["moreau", "newton"]}
+    figure = sweeps._figure("demo", "demo", frame, "e")
+    labels = [line.get_label() for line in figure.figure.axes[0].get_lines()]
+    assert sorted(labels) == ["lzb", "moreau = newton"]
+    plt.close(figure.figure)

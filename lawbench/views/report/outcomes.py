@@ -132,7 +132,7 @@ def _tidy(source: str, kind: str, coordinates: list[str], values: np.ndarray) ->
 
 def _figure(data: pd.DataFrame, coordinates: list[str], case: str) -> Any:
     groups = plots.by_unit(coordinates)
-    widths = [max(2.5, 1.1 * len(k) + 1.5) for k in groups.values()]
+    widths = [max(4.0, 1.2 * len(k) + 2.0) for k in groups.values()]
     fig, axes = plots.figure(1, len(groups), width=max(widths), height=3.6)
     laws = list(dict.fromkeys(data.loc[data["kind"] == "law", "source"]))
     sources = list(dict.fromkeys(data.loc[data["kind"] == "reference", "source"]))
@@ -154,8 +154,12 @@ def _figure(data: pd.DataFrame, coordinates: list[str], case: str) -> Any:
             ax.hlines(values(source), x - 0.45, x + 0.45, colors="k", linestyles=style)
             ax.plot([], [], color="k", linestyle=style, label=source)
         ax.axhline(0.0, color="0.5", linewidth=0.5)
-        ax.set_xticks(x, names, rotation=30 if len(names) > 4 else 0)
+        ax.set_xticks(x, names, rotation=30 if len(names) > 3 else 0)
         ax.set_ylabel(f"velocity [{unit or 'as named'}]")
     axes[0, 0].set_title(case)
-    axes[0, -1].legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    # Below the panels, so the legend never narrows them.
+    handles, labels = axes[0, -1].get_legend_handles_labels()
+    fig.legend(
+        handles, labels, fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=4
+    )
     return fig

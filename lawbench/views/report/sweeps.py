@@ -28,6 +28,8 @@ from lawbench.views.report.runs import Context, axis_value, parsed
 ANCHOR, TITLE, VIEWS = "sweeps", "Sweeps of the sources' systems", ("sweep", "table_path")
 PANELS_PER_ROW = 3
 DASHES = ("-", "--", ":", "-.")
+# A measure's component below this fraction of its largest component is drawn as zero.
+NOISE = 1e-12
 
 
 def build(ctx: Context) -> Section:
@@ -106,7 +108,9 @@ def _tidy(table: pd.DataFrame, axis: str, measures: list[str], lines: list[str])
         tidy: dict[str, Any] = {"law": law, axis: axis_value(row, axis)}
         for name in measures:
             value = parsed(row.get(name))
-            if isinstance(value, list):
+            if isinstance(value, dict):
+                tidy |= {f"{name}[{k}]": v for k, v in value.items() if _number(v)}
+            elif isinstance(value, list):
                 tidy |= {f"{name}[{k}]": v for k, v in enumerate(value) if _number(v)}
             elif _number(value):
                 tidy[name] = value
@@ -122,6 +126,42 @@ def _units(ctx: Context, case: str, axis: str, declared: Mapping[str, str]) -> d
     if axis in specs:
         units[axis] = specs[axis].unit
     return units
+
+
+def _largest(frame: pd.DataFrame, column: str) -> float:
+    """The largest magnitude among the components of ``column``'s measure, every law."""
+    base = column.split("[", 1)[0]
+    parts = [c for c in frame.columns if c == base or c.startswith(f"{base}[")]
+    return float(np.nanmax(np.abs(frame[parts].to_numpy(dtype=float))))
+
+
+def coinciding(frame: pd.DataFrame, axis: str, columns: list[str]) -> dict[str, list[str]]:
+    """The lines to draw, each with the names of every law whose answers it shows.
+
+    One line ``moreau = newton`` instead of one hidden under another. Answers coincide when
+    every value along the axis agrees to 1e-9 of the largest value.
+    """
+    scale = max(float(np.nanmax(np.abs(frame[columns].to_numpy(dtype=float)))), 1e-300)
+    drawn: dict[str, list[str]] = {}
+    series = {
+        law: group.sort_values(axis)[[axis, *columns]].to_numpy(dtype=float)
+        for law, group in frame.groupby("law", sort=True)
+    }
+    for law, values in series.items():
+        first = next(
+            (
+                other
+                for other in drawn
+                if series[other].shape == values.shape
+                and np.allclose(series[other], values, rtol=0, atol=1e-9 * scale, equal_nan=True)
+            ),
+            None,
+        )
+        if first is None:
+            drawn[str(law)] = [str(law)]
+        else:
+            drawn[first].append(str(law))
+    return drawn
 
 
 def _decades(values: pd.Series) -> float:
@@ -147,13 +187,19 @@ def _figure(
     units = units or {}
     # A line named "law (mu=1)" takes its law's colour and a dash pattern of its own values.
     variants = sorted({str(name).partition(" (")[2] for name in frame["law"]})
+    same = coinciding(frame, axis, columns)
+    floors = {c: NOISE * _largest(frame, c) for c in columns}
     for ax, column in zip(axes.flat, columns, strict=False):
         for law, group in frame.groupby("law", sort=True):
+            if law not in same:
+                continue
             ordered = group.sort_values(axis)
+            # Rounding noise of a quantity that is zero (1e-15 beside a component of 4) is 0.
+            shown = ordered[column].where(ordered[column].abs() > floors[column], 0.0)
             base, _, values = str(law).partition(" (")
-            style = {**plots.law_style(base), "label": str(law)}
+            style = {**plots.law_style(base), "label": " = ".join(same[law])}
             style["linestyle"] = DASHES[variants.index(values) % len(DASHES)]
-            ax.plot(ordered[axis], ordered[column], **style)
+            ax.plot(ordered[axis], shown, **style)
         if _decades(frame[axis]) >= 2:
             ax.set_xscale("log")
         ax.set_xlabel(unit_label(axis, units))
