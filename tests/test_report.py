@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 import lawbench
 from lawbench.checks.declared import STUDIES
@@ -97,6 +98,32 @@ def test_velocities_of_different_units_never_share_an_axis():
     fig = outcomes_figure(data, coordinates, "rod")
     labels = [ax.get_ylabel() for ax in fig.axes]
     assert labels == ["velocity [m/s]", "velocity [rad/s]"]
+
+
+def test_an_outcome_figure_with_every_law_keeps_its_plot_area_wide():
+    """Every law, two references and their legend on a two-ball scene: the plot area is at
+    least a third of the figure as saved (its tight bounding box), the legend below it."""
+    coordinates = ["v1 [m/s]", "v2 [m/s]"]
+    laws = [law.name for law in lawbench.LAWS.values()]
+    references = [
+        "ground truth: compliant (tol=1e-10)",
+        "reference eq. (27) (sequential, order=right_to_left)",
+    ]
+    sources = ["before the impact", *laws, *references]
+    kinds = ["v-", *(["law"] * len(laws)), *(["reference"] * len(references))]
+    data = pd.DataFrame(
+        {
+            "source": [s for s in sources for _ in coordinates],
+            "kind": [k for k in kinds for _ in coordinates],
+            "coordinate": coordinates * len(sources),
+            "value": np.linspace(-1.0, 1.0, 2 * len(sources)),
+        }
+    )
+    fig = outcomes_figure(data, coordinates, "ping_pong")
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    whole = fig.get_tightbbox(renderer).width * fig.dpi
+    (ax,) = fig.axes
+    assert ax.get_window_extent(renderer).width >= whole / 3
 
 
 def test_no_path_quantity_is_drawn_under_a_bare_symbol():
