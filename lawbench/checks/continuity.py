@@ -10,7 +10,8 @@ the gaps event by event (`lawbench.checks.gaps.resolve_with_gaps`). The value is
 that remains at the smallest size, relative to the largest velocity; continuous when it is
 below 1e-3. The detail gives the jumps per size and the kinetic angles between the contacts,
 which by Paoli's condition (Brogliato 2010, 'kinetic angle and continuity') predict where rigid
-laws must be discontinuous: angles other than 90 degrees with e > 0.
+laws must be discontinuous: angles other than 90 degrees with e > 0. Each perturbed solve has
+at most `PERTURBED_SECONDS` of wall-clock time; one that runs out refuses the check with why.
 """
 
 from __future__ import annotations
@@ -28,6 +29,9 @@ from lawbench.core.trial import Trial
 
 SIZES = (1e-2, 1e-4, 1e-6)
 CONTINUOUS = 1e-3
+# Wall-clock budget of each perturbed solve (s): a perturbed problem is the size of the
+# original, and one the law cannot solve in this time leaves the check without its premise.
+PERTURBED_SECONDS = 5.0
 
 
 def indentation_scale(problem: ImpactProblem) -> float:
@@ -48,7 +52,9 @@ def indentation_scale(problem: ImpactProblem) -> float:
 
 def jumps(trial: Trial, sizes: tuple[float, ...] = SIZES) -> dict[str, list[float]]:
     """Outcome jump per size, for gap perturbations and for velocity perturbations."""
-    problem, law, options = trial.problem, trial.law, trial.options
+    problem, law = trial.problem, trial.law
+    limit = min(float(trial.options.get("max_seconds", PERTURBED_SECONDS)), PERTURBED_SECONDS)
+    options = {**trial.options, "max_seconds": limit}
     base = trial.outcome.v_plus
     scale = float(np.abs(problem.v).max())
     length = indentation_scale(problem)

@@ -27,27 +27,26 @@ scale ``d*`` (where its spring holds the kinetic energy of its effective mass at
 approach speed: the order of the peak indentation), ``kt = n K d*^(n-1) / eta0^2``, constant
 through the impact: conservative, and Jia's for ``n = 1``.
 
-Numerics: the state is integrated in contact space, ``g' = un``, ``s' = ut - slip``,
-``u' = G F``, ``P' = F``, with ``G`` the Delassus matrix of the normal and tangential
-directions, every contact at once (frictional scenes hold a few contacts), in the scaled
-variables of the frictionless integration, and restarted at every event: a contact closing or
-opening, a damped force crossing zero, a stretch reaching the cone, a slip stopping (the
-events are looked for at four points of every step, so a slip that stops and starts again
-within one step is met). In 3D a sliding stretch turns toward the slip at the rate
-``|ut_perp| / |s|``, without bound as the cone closes with the normal force at the start and
-the end of every contact, where an explicit integrator would need ever shorter steps. On a
-cone narrower than ``tol^(1/2)`` (scaled by ``L``) the friction force follows the slip
-velocity instead: the limit of the spring and slider as the stretch vanishes, its lag behind
-the slip dropped while the force is below ``kt L tol^(1/2)``. Against the integration that
-follows the stretch throughout (Radau at tol = 1e-11) the outcomes of the billiard's massé
-shot, the sphere on a wall, the pencil and the skewed bouncing ball moved by at most 1e-9 at
-tol = 1e-10, for five to twenty times fewer steps. A contact loaded so lightly that its cone
-stays just wider than that for the whole impact still turns stiffly (a billiard shot with
-the ball pressed on the cloth at 8 mm/s: DOP853 did not finish in 60 s), so with spatial
-friction ``method='auto'`` takes LSODA, which turns to implicit steps where the field is
-stiff (that shot in 1.8 s; elsewhere about twice DOP853's time, within 1e-9 of it at
-tol = 1e-10; at tol it lost 3.4e-9 of an elastic head-on impact's energy where DOP853 loses
-1.6e-10, so it runs at tol / 10, which brings that to 4.3e-10).
+Numerics: the state is integrated in contact space, ``g' = un``, ``s' = ut - slip``, ``u' = G F``,
+``P' = F``, with ``G`` the Delassus matrix of the normal and tangential directions, every contact at
+once (frictional scenes hold a few contacts), in the scaled variables of the frictionless
+integration, and restarted at every event: a contact closing or opening, a damped force crossing
+zero, a stretch reaching the cone, a slip stopping (the events are looked for at four points of
+every step, so a slip that stops and starts again within one step is met). In 3D a sliding stretch
+turns toward the slip at the rate ``|ut_perp| / |s|``, without bound as the cone closes with the
+normal force at the start and the end of every contact, where an explicit integrator would need ever
+shorter steps. On a cone narrower than ``tol^(1/2)`` (scaled by ``L``; tol taken at most 1e-4,
+looser the switches chattered) the friction force follows the slip velocity instead: the limit of
+the spring and slider as the stretch vanishes, its lag behind the slip dropped while the force is
+below ``kt L tol^(1/2)``. Against the integration that follows the stretch throughout (Radau at tol
+= 1e-11) the outcomes of the billiard's massé shot, the sphere on a wall, the pencil and the skewed
+bouncing ball moved by at most 1e-9 at tol = 1e-10, for five to twenty times fewer steps. A contact
+loaded so lightly that its cone stays just wider than that for the whole impact still turns stiffly
+(a billiard shot with the ball pressed on the cloth at 8 mm/s: DOP853 did not finish in 60 s), so
+with spatial friction ``method='auto'`` takes LSODA, which turns to implicit steps where the field
+is stiff (that shot in 1.8 s; elsewhere about twice DOP853's time, within 1e-9 of it at tol = 1e-10;
+at tol it lost 3.4e-9 of an elastic head-on impact's energy where DOP853 loses 1.6e-10, so it runs
+at tol / 10, which brings that to 4.3e-10).
 """
 
 from __future__ import annotations
@@ -68,7 +67,10 @@ if TYPE_CHECKING:
 
 # The scaled stretch that carries the direction of a slip starting from zero stretch.
 SEED = 1e-12
-# In 3D a slip whose cone is narrower than tol^SHORT_POWER (scaled) follows the slip velocity.
+# In 3D a slip whose cone is narrower than tol^SHORT_POWER (scaled) follows the slip velocity,
+# tol at most LOOSEST_SHORT: from tol = 1e-3 on, the cones it switched at were so wide that the
+# switches met again and again (the bouncing ball and the sphere ran out of their 60 s).
+LOOSEST_SHORT = 1e-4
 SHORT_POWER = 0.5
 
 
@@ -97,7 +99,7 @@ class FrictionalIntegration(Integration):
         # Newtons per scaled stretch, and scaled cone radius per newton of normal force.
         self.kt_scaled = self.kt * self.L
         self.cone = self.mu / self.kt_scaled
-        self.short = options["tol"] ** SHORT_POWER if self.d > 1 else 0.0
+        self.short = min(options["tol"], LOOSEST_SHORT) ** SHORT_POWER if self.d > 1 else 0.0
         m, md = problem.m, problem.m * self.d
         bounds = np.cumsum([0, m, md, m, md])
         self.parts = [slice(bounds[i], bounds[i + 1]) for i in range(4)]
