@@ -348,6 +348,17 @@ def test_every_declared_study_is_on_the_page_or_listed_with_why_it_is_not(report
         assert (study.name in ran) != (f"`{study.name}`: " in line), study.name
 
 
+def test_the_paradox_table_is_tidy_one_row_per_scene_and_law(report):
+    """No pseudo-law row: the points where no law gains are said in a sentence per map."""
+    table = pd.read_csv(report / "paradoxes_regions.csv")
+    assert not table.duplicated(["case", "law"]).any()
+    assert set(table["law"]) <= set(lawbench.LAWS.names())
+    page = (report / "report.md").read_text()
+    for case in set(table["case"]):
+        pattern = rf"On `{case}`, every law answered at \d+ of the \d+ points; at \d+ of them"
+        assert re.search(pattern, page), case
+
+
 def test_budget_cells_say_which_budget_and_after_how_long(report):
     attention = pd.read_csv(report / "stability_attention.csv")
     budget = attention[attention["verdict"] == "budget"]
