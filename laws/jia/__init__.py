@@ -86,7 +86,7 @@ APPROACH = 1e-12
 
 
 class Jia(Law):
-    """Jia's tangential compliance (one contact) and state transitions (frictionless chains)."""
+    """Jia's tangential compliance at every frictional contact and state transitions at several."""
 
     name = "jia"
     summary = (
