@@ -205,7 +205,7 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
         diagnostics["tangential_stiffness_ratio"] = eta0_sq[0] if m == 1 else eta0_sq.tolist()
     if any(c.exponent != 1 for c in problem.contacts) and m > 1:
         diagnostics["springs"] = "linear: the contacts' exponent is not read"
-    path = _path(impact, eta0_sq) if options["path"] else None
+    path = _path(impact) if options["path"] else None
     Pt = state[impact.It] if d else None
     Pn = state[:m]
     if not d:
@@ -221,7 +221,7 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
     return Outcome.from_impulses(problem, Pn, Pt, diagnostics=diagnostics, path=path)
 
 
-def _path(impact: SpringImpact, eta0_sq: np.ndarray) -> dict[str, np.ndarray]:
+def _path(impact: SpringImpact) -> dict[str, np.ndarray]:
     """The impulse curve from the samples of ``impact``: impulses, energies, velocities."""
     m, d = impact.m, impact.d
     samples = np.array(impact.record.samples)
@@ -233,7 +233,7 @@ def _path(impact: SpringImpact, eta0_sq: np.ndarray) -> dict[str, np.ndarray]:
         "Pn": states[:, :m],
         "Pt": states[:, impact.It],
         "En": states[:, m : 2 * m] ** 2,
-        "Et": np.sum(g**2, axis=2) * impact.kappa0 / (4 * eta0_sq),
+        "Et": np.sum(g**2, axis=2) * impact.kappa0 / (4 * impact.springs.eta0_sq),
         "un": velocities[:, :m],
         "ut": velocities[:, m:],
     }

@@ -159,6 +159,7 @@ def headline(ctx: Context) -> list[Any]:
 
 
 def _preamble(ctx: Context, config: Config, seconds: float) -> list[str]:
+    left_out = "; ".join(f"`{name}`: {why}" for name, why in ctx.left_out.items())
     return [
         f"Mode `{config.mode}`: computed in {seconds:.0f} s (before drawing the figures) "
         f"with {config.workers} worker processes (executor `{config.executor}`; wall-clock "
@@ -170,13 +171,5 @@ def _preamble(ctx: Context, config: Config, seconds: float) -> list[str]:
         f"lawbench {version('lawbench')}, Python {platform.python_version()}, numpy "
         f"{np.__version__}, scipy {scipy.__version__}, matplotlib {matplotlib.__version__}.",
         *dict.fromkeys(f"Note: {note}." for note in ctx.notes),
-        *(
-            [
-                "Declared studies left out of this page: "
-                + "; ".join(f"`{name}`: {why}" for name, why in ctx.left_out.items())
-                + "."
-            ]
-            if ctx.left_out
-            else []
-        ),
+        *([f"Declared studies left out of this page: {left_out}."] if left_out else []),
     ]

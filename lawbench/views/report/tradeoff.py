@@ -11,8 +11,8 @@ repeats. Two measures, drawn on two panels:
   (0 for an exact law; none for a knob that chooses an ordering, not an accuracy).
 
 The ground truth's own model is the reference and never a candidate. Over the laws under test the
-Pareto front (no point both cheaper and closer to the ground truth) is marked, a table gives, per
-scene, the cheapest law whose model error reaches each level, and another says in one sentence
+Pareto front (no point both cheaper and closer to the ground truth) is marked, and a table gives,
+one row per scene, the cheapest law whose model error reaches each level and a sentence that says
 which law to use and at what cost.
 """
 
