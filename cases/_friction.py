@@ -16,8 +16,8 @@ def springs_with_friction(detail: str) -> GroundTruth:
         "Coulomb slider, integrated in time: stick, slip and slip reversal happen as the "
         "forces decide, during the impact, and several contacts share it as their stiffnesses "
         "decide, which no impulse-level law follows (Jia, IJRR 2013, the same springs in "
-        "impulse space; Brogliato 2010, compliant contacts); it never creates energy, and "
-        f"no such model reaches e = 0; {detail}",
+        "impulse space; Brogliato 2010, compliant contacts); it never creates energy, and at "
+        f"e = 0 its contacts are plastic; {detail}",
         law="compliant",
         options={"tol": 1e-10},
     )

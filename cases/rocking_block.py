@@ -143,8 +143,9 @@ class RockingBlock(Case):
         "corner sticks, the pivot lifts off: width <= sqrt(2) height): angular momentum about "
         "the landing corner is kept. Elsewhere compliant contact with friction at both "
         "corners, integrated in time (Hunt-Crossley with Flores' damping from e, tangential "
-        "springs and Coulomb sliders), which decides whether the pivot lifts off and the "
-        "landing corner slides; no such model reaches e = 0",
+        "springs and Coulomb sliders, plastic corners at e = 0), which decides whether the "
+        "pivot lifts off and the landing corner slides; with tangential springs much stiffer "
+        "than the normal ones its plastic corners reach Housner's ratio",
         reference="Housner",
         law="compliant",
         options={"tol": 1e-10},

@@ -95,6 +95,43 @@ def test_hertz_without_damping_refuses_e_below_one():
         LAW.resolve(problem, model="hertz")
 
 
+@pytest.mark.parametrize("model", ["kelvin_voigt", "hertz", "hunt_crossley"])
+def test_a_plastic_contact_lets_go_where_its_indentation_stops_growing(model):
+    """At e = 0 a contact is plastic: its spring loads it and it lets go where the
+    indentation stops growing, so two bodies leave with one normal velocity (the binary
+    impact at e = 0, Brogliato 2010) and the path's force ends at zero."""
+    problem = two_balls(Contact(e=0.0, stiffness=1e6, exponent=1.5), masses=(2.0, 0.5))
+    outcome = LAW.resolve(problem, model=model, path=True)
+    np.testing.assert_allclose(outcome.v_plus, [0.8, 0.8], atol=1e-12)
+    assert outcome.path["force"].max() > 0
+    assert outcome.diagnostics["damping"] == [0.0]
+
+
+@pytest.mark.parametrize("model", ["kelvin_voigt", "hunt_crossley"])
+@pytest.mark.parametrize(("width", "height"), [(0.5, 1.0), (0.4, 1.2), (0.7, 1.0)])
+def test_a_plastic_landing_corner_meets_the_lectures_one_contact_formulas(model, width, height):
+    """Brogliato 2010, the rocking block: without friction and with height >= sqrt(2) width the
+    pivot separates and the landing corner alone stops (e = 0), ``vy+ = (2 L^2 - l^2) /
+    (l^2 + 4 L^2) vy-`` and ``omega+ = (l^2 - 2 L^2) / (l^2 + 4 L^2) omega-`` (L the width,
+    l the height)."""
+    outcome = lawbench.solve(
+        "compliant", "rocking_block", {"model": model}, mu=0.0, e=0.0, width=width, height=height
+    )
+    L2, l2 = width**2, height**2
+    vy, omega = -width / 2, 1.0  # rotating about the pivot at omega = 1 rad/s
+    assert outcome.v_plus[1] == pytest.approx((2 * L2 - l2) / (l2 + 4 * L2) * vy, abs=1e-12)
+    assert outcome.v_plus[2] == pytest.approx((l2 - 2 * L2) / (l2 + 4 * L2) * omega, abs=1e-12)
+    assert outcome.Pn[1] == 0.0
+
+
+def test_kelvin_voigt_ending_at_zero_force_refuses_what_it_cannot_reach():
+    """Brogliato 2010: ended where its force returns to zero, an underdamped Kelvin-Voigt
+    contact reaches only e > exp(-2); e = 0 is the plastic contact."""
+    problem = two_balls(Contact(e=0.1, stiffness=1e6, exponent=1))
+    with pytest.raises(lawbench.NotApplicable, match="out of its reach"):
+        LAW.resolve(problem, model="kelvin_voigt", termination="force")
+
+
 def test_a_contact_that_closes_later_is_met_after_free_flight():
     """With a gap, the balls fly freely, then collide: the same outcome as with no gap."""
     contact = Contact(stiffness=1e6, exponent=1.5)

@@ -1,16 +1,16 @@
 """Compliant contacts with tangential springs and Coulomb sliders (the frictional yardstick)."""
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 
 import lawbench
+from lawbench.views import cli
 
 FRICTIONAL = [case.name for case in lawbench.CASES.values() if case.requires.friction]
 SINGLE_CONTACT = [name for name in FRICTIONAL if lawbench.CASES[name].build().m == 1]
-# e = 0 (the rocking block's default) has no compliant model: a contact needs some rebound.
-SOME_REBOUND = {"rocking_block": {"e": 0.5}}
 
 
 def with_mu(problem, mu):
@@ -41,13 +41,23 @@ def test_linear_springs_at_e_1_agree_with_jia(case):
     assert relative(compliant.outcome.Pt, jia.Pt, jia.Pn) <= 1e-6
 
 
+@pytest.mark.parametrize("case", FRICTIONAL)
+def test_every_frictional_scene_is_answered_at_its_defaults(case, capsys):
+    """``lawbench solve compliant SCENE`` exits 0 on every frictional scene, with no energy
+    created and every tangential impulse in its cone."""
+    assert cli.main(["solve", "compliant", case]) == 0
+    report = capsys.readouterr().out
+    assert re.search(r"energy_gain\s+holds", report)
+    assert re.search(r"friction_cone\s+holds", report)
+
+
 @pytest.mark.parametrize("mu", [0.0, 1e-3, 1.0, 1000.0])
 @pytest.mark.parametrize("case", FRICTIONAL)
 def test_never_creates_energy_and_holds_the_cone(case, mu):
     """Brogliato 2010, compliant contacts: springs give back what they stored, dashpots and
     sliders only take; Coulomb's cone bounds the friction force at every instant, so the
     impulse too."""
-    problem = with_mu(lawbench.CASES[case].build(**SOME_REBOUND.get(case, {})), mu)
+    problem = with_mu(lawbench.CASES[case].build(), mu)
     trial = lawbench.evaluate("compliant", problem, {"tol": 1e-8})
     outcome = trial.outcome
     assert outcome.dT <= 1e-9 * outcome.T_minus

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -132,6 +133,27 @@ def test_moreau_without_friction_gives_the_lectures_one_contact_formulas(e, widt
         v_plus, [v[0], vy_ratio * v[1], omega_ratio * v[2]], rtol=1e-12, atol=1e-14
     )
     assert trial.outcome.Pn[1] == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("model", ["hunt_crossley", "kelvin_voigt"])
+def test_plastic_compliant_corners_reach_housner_as_their_tangential_springs_stiffen(model):
+    """Housner 1963 is the rigid limit of the ground truth: plastic compliant corners (e = 0)
+    whose tangential springs are 1e4 times stiffer than the normal ones keep the angular
+    momentum about the landing corner, omega+ = ratio omega- (0.7 here) to 1e-4. At Mindlin's
+    ratio (eta0^2 = 17/14) the tangential spring still holds energy when the landing corner
+    lets go and releases it: omega+ is 0.44."""
+    problem = lawbench.CASES["rocking_block"].build()
+    errors = []
+    for ratio in (17 / 14, 1e-2, 1e-4):
+        contacts = [
+            dataclasses.replace(c, tangential_stiffness_ratio=ratio) for c in problem.contacts
+        ]
+        stiff = dataclasses.replace(problem, contacts=tuple(contacts))
+        outcome = lawbench.LAWS["compliant"].resolve(stiff, model=model)
+        errors.append(abs(outcome.v_plus[2] - housner_ratio(0.5, 1.0)))
+    assert errors[2] < 1e-4
+    assert errors[2] < errors[1] < errors[0]
+    assert errors[0] > 0.2
 
 
 def test_the_printed_omega_formula_does_not_conserve_energy_at_e_1():

@@ -30,7 +30,18 @@ termination with the contact's effective mass ``1 / G_jj``; Hunt-Crossley applie
 with ``v0`` the largest pre-impact approach speed of the scene, for every contact and the whole
 impact (a contact that a wave closes later has no approach speed of its own: taking its speed
 at closure, which can be near zero, makes the damping unbounded); Hertz is elastic and refuses
-``e < 1``.
+``0 < e < 1``. Kelvin-Voigt ended where its force returns to zero reaches only e > exp(-2).
+
+Plastic contacts: at ``e = 0`` with no damping given, no dashpot reaches the coefficient (a
+critically damped gap never reopens; Hunt-Crossley's damping grows without bound), so the
+contact is plastic whatever the model: its spring alone loads it while the indentation grows,
+and where the indentation stops growing the force drops to zero and the indentation reached
+stays, the gap measured again from there (a contact pushed in again loads its spring from
+zero). This is Walton and Braun's hysteretic spring (J. Rheol. 30, 1986; unloading stiffness
+``k / e^2``) as e tends to 0, except that a reload follows the loading law rather than a rigid
+unloading line. Two bodies leave a plastic contact with one normal velocity, the binary impact
+at e = 0, and the energy the spring held is lost; with friction the tangential spring is
+released with it.
 
 Numerics: scipy's ``solve_ivp`` (DOP853 by default) in contact space, ``g' = un``,
 ``un' = G F``, ``Pn' = F`` with ``G = Wn.T M^-1 Wn`` the Delassus matrix, in scaled variables

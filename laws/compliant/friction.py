@@ -219,6 +219,7 @@ class FrictionalIntegration(Integration):
         following = np.zeros(m, dtype=bool)
         while True:
             g, s, un, _, _ = self.split(y)
+            self.let_go(g, un)
             if self.at_rest(g, un):
                 break
             closed = g <= -self.band
@@ -309,9 +310,11 @@ class _Mode:
         self.acting = np.flatnonzero(closed)
         self.sticking = closed & ~slipping & (integration.mu > 0)
         self.damped = integration.clipped and bool(integration.c[closed].any())
+        self.plastic = closed & integration.plastic
         # A gap fires as it passes its band away from its side; a stretch reaching the cone and
         # a slip speed falling to zero fire as they fall below zero; a 3D cone widening past
-        # or narrowing below ``short`` as it crosses it.
+        # or narrowing below ``short`` as it crosses it; a plastic contact's gap rate as it
+        # turns from approach to separation.
         gaps = np.where(closed, 1.0, -1.0)
         m = closed.size
         self.direction = np.concatenate(
@@ -319,6 +322,7 @@ class _Mode:
                 gaps,
                 -np.ones(2 * m),
                 np.where(following, 1.0, -1.0),
+                np.ones(m),
                 np.zeros(m) if self.damped else np.zeros(0),
             ]
         )
@@ -336,6 +340,7 @@ class _Mode:
             np.where(self.sticking, at["radius"] - at["size"], 1.0),
             np.where(self.slipping, at["lam"], 1.0),
             np.where(narrow, at["radius"] - integration.short, 1.0),
+            np.where(self.plastic, un, -1.0),
         ]
         if self.damped:
             j = np.flatnonzero(self.closed)

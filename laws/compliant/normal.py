@@ -45,19 +45,19 @@ def kelvin_voigt_restitution(ratio: float, termination: str) -> float:
 
 
 def _kelvin_voigt_ratio(e: float, termination: str) -> float:
-    """The damping ratio whose Kelvin-Voigt restitution coefficient is ``e``.
+    """The damping ratio whose Kelvin-Voigt restitution coefficient is ``e > 0``.
 
-    Raises `NotApplicable` for the coefficients no underdamped contact reaches: ``e = 0`` (at
-    critical damping the gap never reopens) and, when the contact ends as its force returns to
-    zero, ``e < exp(-2)`` (the limit of that closed form as the ratio tends to 1).
+    Raises `NotApplicable` for the coefficients no underdamped contact reaches when the contact
+    ends as its force returns to zero: ``e <= exp(-2)``, the limit of that closed form as the
+    ratio tends to 1 (a gap that must reopen reaches every ``e > 0``; ``e = 0`` is the plastic
+    contact).
     """
     if e >= 1.0:
         return 0.0
-    lowest = 0.0 if termination == "gap" else math.exp(-2.0)
-    if e <= lowest:
+    if termination == "force" and e <= math.exp(-2.0):
         raise NotApplicable(
-            f"compliant: a Kelvin-Voigt contact ending at {termination} reaches only "
-            f"e > {lowest:.4g} when underdamped; e = {e:g} is out of its reach"
+            f"compliant: a Kelvin-Voigt contact ending at force reaches only e > "
+            f"{math.exp(-2.0):.4g} when underdamped; e = {e:g} is out of its reach"
         )
     return scipy.optimize.brentq(
         lambda z: kelvin_voigt_restitution(z, termination) - e, 0.0, 1.0 - 1e-15, xtol=1e-15
@@ -93,6 +93,9 @@ class Integration:
         )
         self.e = problem.restitution("kinematic")
         self.given_damping = np.array([c.damping for c in contacts])
+        # At e = 0 with no damping given a contact is plastic: its spring alone loads it, and
+        # it lets go where its indentation stops growing.
+        self.plastic = (self.e == 0.0) & (self.given_damping == 0.0)
         G = scipy.sparse.csc_array(problem.delassus)
         diagonal = G.diagonal()
         self.V = float(max(np.abs(problem.un).max(), 1e-300))
@@ -121,7 +124,7 @@ class Integration:
 
     def _initial_damping(self, G: np.ndarray) -> np.ndarray:
         c = self.given_damping.copy()
-        derive = c == 0.0
+        derive = (c == 0.0) & ~self.plastic
         if self.model == "hertz" and (derive & (self.e < 1)).any():
             j = int(np.flatnonzero(derive & (self.e < 1))[0])
             raise NotApplicable(
@@ -133,8 +136,6 @@ class Integration:
                 ratio = _kelvin_voigt_ratio(self.e[j], self.options["termination"])
                 c[j] = 2.0 * ratio * math.sqrt(self.k[j] / G[j])
         if self.model == "hunt_crossley":
-            if (derive & (self.e <= 0)).any():
-                raise NotApplicable("compliant: hunt_crossley needs e > 0 for its damping rule")
             rule = DAMPING_RULES[self.options["damping_rule"]]
             for j in np.flatnonzero(derive):
                 c[j] = rule(self.e[j], self.V)
@@ -196,6 +197,15 @@ class Integration:
         d = np.maximum(-self.L * g, 0.0)
         return self.k * d ** (self.n + 1) / (self.n + 1)
 
+    def let_go(self, g: np.ndarray, un: np.ndarray) -> None:
+        """Open, in place, every closed plastic contact whose indentation no longer grows.
+
+        Its force drops to zero and the indentation it reached stays: the scaled gap is measured
+        again from there, so a contact pushed in again loads its spring from zero.
+        """
+        turned = self.plastic & (g <= -self.band) & (un >= 0.0)
+        g[turned] = 0.0
+
     def at_rest(self, g: np.ndarray, un: np.ndarray) -> bool:
         """Whether no contact acts and none approaches faster than ``tol`` V."""
         return bool((g > -self.band).all()) and bool((un >= -self.rest).all())
@@ -213,7 +223,10 @@ class Integration:
         self.history: list[tuple[float, np.ndarray, np.ndarray]] = []
         # Gaps are never negative at the start: every contact is open.
         self._keep(t, g, np.zeros(m, dtype=bool), np.zeros(0))
-        while not self.at_rest(g, un):
+        while True:
+            self.let_go(g, un)
+            if self.at_rest(g, un):
+                break
             closed = g <= -self.band
             closing = ~closed & (un < 0)
             # The first contact to close among those no closed contact pushes: in closed form.
@@ -305,9 +318,12 @@ class _Mode:
         self.G = for_products(integration.G[rows][:, self.closed].toarray())
         self.band = integration.band[rows]
         self.damped = integration.clipped and bool(integration.c[self.closed].any())
+        self.plastic = integration.plastic[rows] & closed[rows]
         # A gap fires only as it passes its band away from its side: a closed contact (on its
-        # band at the restart that closed it) opening, an open one closing.
+        # band at the restart that closed it) opening, an open one closing; a closed plastic
+        # contact's gap rate as it turns from approach to separation.
         self.direction = np.where(closed[rows], 1.0, -1.0)
+        self.direction = np.concatenate([self.direction, np.ones(self.size)])
         if self.damped:
             self.direction = np.concatenate([self.direction, np.zeros(self.closed.size)])
 
@@ -322,11 +338,11 @@ class _Mode:
         return np.concatenate([un, self.G @ f, f])
 
     def switches(self, t: float, y: np.ndarray) -> np.ndarray:
-        """A gap passing its band; with clipped dashpots, the sign of each closed law."""
+        """Gaps passing their bands, plastic contacts turning, clipped laws changing sign."""
         g, un, _ = self.split(y)
-        gaps = g + self.band
-        if not self.damped:
-            return gaps
-        c = self.integration.c[self.closed]
-        sign = self.integration.law_sign(g[self.acting], un[self.acting], self.closed)
-        return np.concatenate([gaps, np.where(c > 0, sign, 1.0)])
+        parts = [g + self.band, np.where(self.plastic, un, -1.0)]
+        if self.damped:
+            c = self.integration.c[self.closed]
+            sign = self.integration.law_sign(g[self.acting], un[self.acting], self.closed)
+            parts.append(np.where(c > 0, sign, 1.0))
+        return np.concatenate(parts)
