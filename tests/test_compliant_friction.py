@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import lawbench
+from lawbench.numerics.transforms import grazing
 from lawbench.views import cli
 
 FRICTIONAL = [case.name for case in lawbench.CASES.values() if case.requires.friction]
@@ -98,3 +99,20 @@ def test_several_spatial_contacts_at_once():
     assert "tangential springs" in trial.outcome.diagnostics["formulation"]
     checks = lawbench.run_checks(trial)
     assert {str(r.verdict) for r in checks.values()} <= {"holds", "refused"}
+
+
+@pytest.mark.parametrize("e", [0.0, 1.0])
+def test_a_grazing_slip_costs_no_more_steps_than_a_steep_one(e):
+    """A rod that grazes the floor (approach 1e-12 m/s, its sliding kept) slides through the
+    whole impact, so |Pt| = mu Pn (Coulomb, Brogliato 2010), and its stretch, on the cone,
+    grows with the cone alone: the integration takes the steps of a 1e-4 m/s approach, not the
+    thousands a slip 1e12 times faster than the cone's growth would force if its rounding
+    entered the stretch."""
+    steps = {}
+    for speed in (1e-4, 1e-12):
+        problem = grazing(lawbench.CASES["falling_rod"].build(e=e), speed)
+        outcome = lawbench.LAWS["compliant"].resolve(problem)
+        steps[speed] = outcome.diagnostics["steps"]
+        mu = problem.contacts[0].mu
+        np.testing.assert_allclose(np.abs(outcome.Pt), mu * outcome.Pn, rtol=1e-9)
+    assert steps[1e-12] <= 2 * steps[1e-4]

@@ -147,14 +147,18 @@ class FrictionalIntegration(Integration):
         Fn_rate = np.zeros(m)
         Fn_rate[j] = self.force_rate(g[j], un[j], u_rate[:m][j], j)
         cone_rate = self.cone * np.where(Fn > 0, Fn_rate, 0.0)
-        lam = np.einsum("jd,jd->j", direction, ut) - cone_rate
+        along = np.einsum("jd,jd->j", direction, ut)
+        lam = along - cone_rate
         s_rate = ut * closed[:, None]
         # The sliders' power, ``mu Fn lam`` (J per unit of scaled time).
         slid = float((radius * self.kt_scaled * lam * self.L)[slipping].sum())
         if slipping.any():
             # On the cone the stretch grows with it and turns toward the slip (it does not
-            # turn where it follows the slip already).
-            s_rate[slipping] -= lam[slipping, None] * direction[slipping]
+            # turn where it follows the slip already): ``ut - lam n`` written as the slip
+            # across the stretch plus the cone's growth, so that a slip much faster than the
+            # cone grows (a grazing approach) does not leave the rounding of ``lam`` in it.
+            across = ut[slipping] - along[slipping, None] * direction[slipping]
+            s_rate[slipping] = across + cone_rate[slipping, None] * direction[slipping]
         return {
             "Fn": Fn,
             "radius": radius,
@@ -243,7 +247,11 @@ class FrictionalIntegration(Integration):
             # A 3D slip on a cone narrower than ``short`` follows the slip velocity.
             narrow = slipping & (self.field(y, closed, slipping)["radius"] < self.short)
             y = self.on_cones(y, closed, slipping, narrow | following)
-            following = narrow
+            # A stretch met on its cone where its slip would run backward (lam < 0: within
+            # rounding of a slip that just stopped) sticks; sliding there would feed the slip.
+            backward = slipping & (self.field(y, closed, slipping, narrow)["lam"] < 0)
+            slipping &= ~backward
+            following = narrow & slipping
             mode = _Mode(self, closed, slipping, following)
             event = integrator.to_event(
                 mode.rhs, t, y, mode.switches, mode.direction, on_step=partial(self._on_step, mode)
