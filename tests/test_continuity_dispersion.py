@@ -122,3 +122,23 @@ def test_kinetic_angle_of_the_rocking_block(width, height):
     problem = lawbench.CASES.get("rocking_block").build(width=width, height=height, mu=0.0)
     cosine = (height**2 - 2 * width**2) / (height**2 + 4 * width**2)
     assert kinetic_angles(problem)[0, 1] == pytest.approx(np.degrees(np.arccos(cosine)), abs=1e-9)
+
+
+def test_a_cell_pays_for_its_perturbed_solves_once(monkeypatch):
+    """The continuity check and the jumps measure of one cell share the perturbed solves; a
+    new trial, or other sizes, solves again."""
+    trial = lawbench.evaluate("newton", "three_ball_chain")
+    law = type(trial.law)
+    calls = []
+    resolve = law.resolve
+    monkeypatch.setattr(
+        law, "resolve", lambda self, *a, **k: calls.append(1) or resolve(self, *a, **k)
+    )
+    first = jumps(trial, (1e-2, 1e-4))
+    solved = len(calls)
+    assert solved > 0
+    assert jumps(trial, (1e-2, 1e-4)) is first
+    assert len(calls) == solved
+    jumps(trial, (1e-2,))
+    jumps(lawbench.evaluate("newton", "three_ball_chain"), (1e-2, 1e-4))
+    assert len(calls) > solved + solved // 2
