@@ -97,6 +97,17 @@ def _row(result: Result, task: Task, budget_s: float) -> dict[str, Any]:
     return Record.failed(task.index, task.study, task.job, error, result.seconds).row()
 
 
+# Seconds past its budget before the guard kills a worker whose cell ignored the alarm (a loop in
+# compiled code): the alarm stops a cell inside its worker, which keeps its imports and its
+# answers solved again, and a killed worker's replacement pays for them anew.
+KILL_GRACE_S = 2.0
+
+
+def _guarded(guard: Guard, task: Task, budget_s: float) -> int:
+    """Submit ``task`` to ``guard``: its alarm rings at ``budget_s``, the kill comes after."""
+    return guard.submit(compute, task, budget_s, budget=budget_s + KILL_GRACE_S)
+
+
 # The guard of a Dask worker process, started with its first chunk.
 _WORKER_GUARD: Guard | None = None
 
@@ -106,7 +117,7 @@ def _dask_chunk(chunk: list[tuple[int, Task]], budget_s: float) -> list[tuple[in
     global _WORKER_GUARD
     if _WORKER_GUARD is None:
         _WORKER_GUARD = Guard(1, budget_s)
-    handles = {_WORKER_GUARD.submit(compute, task, budget=budget_s): k for k, task in chunk}
+    handles = {_guarded(_WORKER_GUARD, task, budget_s): k for k, task in chunk}
     tasks = dict(chunk)
     return [
         (handles[h], _row(r, tasks[handles[h]], budget_s))
@@ -181,7 +192,9 @@ class Executor:
                 yield position, compute(task, self.budget_s)
         elif self.kind == "processes":
             assert self._guard is not None, "use the executor in a with block"
-            handles = {self._guard.submit(compute, task): k for k, task in enumerate(tasks)}
+            handles = {
+                _guarded(self._guard, task, self.budget_s): k for k, task in enumerate(tasks)
+            }
             for handle, result in self._guard.as_completed(handles):
                 position = handles[handle]
                 yield position, _row(result, tasks[position], self.budget_s)
