@@ -68,7 +68,7 @@ def quick(tmp_path_factory):
 
 
 def figures_of(page: str) -> list[str]:
-    return re.findall(r'<img src="([^"]+)\.png"', page)
+    return re.findall(r'<img src="([^"]+)\.svg"', page)
 
 
 def runs(out: Path) -> dict[str, pd.DataFrame]:
@@ -158,7 +158,7 @@ def test_the_page_writes_every_file_escapes_and_keeps_the_rerun_command(tmp_path
         ],
     )
     write_page(tmp_path, "Title", ["Intro."], [section], "lawbench report --quick --out X")
-    for name in ("t.csv", "f.png", "f.svg", "f.csv", "index.html", "report.md"):
+    for name in ("t.csv", "f.svg", "f.csv", "index.html", "report.md"):
         assert (tmp_path / name).stat().st_size > 0, name
     page = (tmp_path / "index.html").read_text()
     assert 'id="row-1"' in page and 'href="#row-1"' in page and "<code>code</code>" in page
@@ -182,7 +182,7 @@ def test_every_section_is_in_both_pages(report):
     assert "This section failed" not in page
 
 
-def test_every_figure_has_png_svg_csv_and_a_caption_with_the_rerun_command(report):
+def test_every_figure_has_svg_csv_and_a_caption_with_the_rerun_command(report):
     page = (report / "index.html").read_text()
     names = figures_of(page)
     expected = {"stability_errors", "paradoxes_falling_rod", "paradoxes_double_pendulum"}
@@ -193,7 +193,7 @@ def test_every_figure_has_png_svg_csv_and_a_caption_with_the_rerun_command(repor
     expected |= {"inside_darboux_keller_lamina"}
     assert expected <= set(names)
     for name in names:
-        for ext in ("png", "svg", "csv"):
+        for ext in ("svg", "csv"):
             assert (report / f"{name}.{ext}").stat().st_size > 0, (name, ext)
     captions = re.findall(r"<figcaption>(.*?)</figcaption>", page, flags=re.S)
     assert len(captions) == len(names)
@@ -485,7 +485,7 @@ def test_the_quick_report_end_to_end(quick):
         assert f'<h2 id="{anchor}">' in page, anchor
     assert "This section failed" not in page
     for name in figures_of(page):
-        for ext in ("png", "svg", "csv"):
+        for ext in ("svg", "csv"):
             assert (out / f"{name}.{ext}").stat().st_size > 0, (name, ext)
     for scene in ("three_ball_chain", "lamina", "bead_column"):
         assert f"tradeoff_{scene}" in figures_of(page), scene

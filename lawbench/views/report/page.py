@@ -66,7 +66,7 @@ PARTS = {
     "{% for c in row.cells %}<td>{{ c }}</td>{% endfor %}</tr>{% endfor %}</tbody></table>"
     '<p class="caption">{{ caption | inline }}</p>',
     "figure": '<figure id="{{ block.name }}"><a href="{{ block.name }}.svg">'
-    '<img src="{{ block.name }}.png" alt="{{ block.name }}"></a>'
+    '<img src="{{ block.name }}.svg" alt="{{ block.name }}"></a>'
     "<figcaption>{{ caption | inline }}</figcaption></figure>",
     "mark": '{% if m.link %}<a class="mark {{ m.verdict | css }}" href="{{ m.link }}" '
     'title="{{ m.reason }}">{% else %}<span class="mark {{ m.verdict | css }}" '
@@ -209,7 +209,7 @@ def _markdown(block: Block, rerun: str) -> str:
         return "Verdicts: " + "; ".join(m.markdown() + f" {m.reason}" for m in block.marks)
     caption = _caption(block, rerun)
     if isinstance(block, Figure):
-        return f"![{block.name}]({block.name}.png)\n\n{caption}"
+        return f"![{block.name}]({block.name}.svg)\n\n{caption}"
     frame = block.frame
     lines = [
         f'<a id="{block.name}"></a>\n',
@@ -225,10 +225,12 @@ def _markdown(block: Block, rerun: str) -> str:
 
 
 def save_figure(figure: MplFigure, name: str, data: pd.DataFrame, out: Path) -> None:
-    """Write ``NAME.png``, ``NAME.svg`` (reproducible: fixed ids, no date) and ``NAME.csv``."""
+    """Write ``NAME.svg`` (reproducible: fixed ids, no date) and ``NAME.csv``.
+
+    The page shows the vector image itself: a raster copy as well doubled the drawing time.
+    """
     FigureCanvasAgg(figure)
     # A tight bounding box keeps the legends placed outside the axes.
-    figure.savefig(out / f"{name}.png", dpi=100, bbox_inches="tight")
     with rc_context({"svg.hashsalt": "lawbench"}):
         figure.savefig(out / f"{name}.svg", metadata={"Date": None}, bbox_inches="tight")
     data.to_csv(out / f"{name}.csv", index=False)
