@@ -305,12 +305,13 @@ STUDIES.register(
         "(degrees) and the curvature of its path on the cloth (1/m) against the cue's elevation "
         "(degrees)",
         cases=("billiard",),
-        grid={"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]},
+        grid={"elevation": [0.0, 30.0, 60.0, 75.0]},
         params={"offset_side": 0.012},
         measures=MEASURES,
         axes=("elevation",),
         units=UNITS,
         view="sweep",
+        full={"grid": {"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 70.0, 75.0, 80.0]}},
     )
 )
 STUDIES.register(
@@ -320,12 +321,17 @@ STUDIES.register(
         "spin (rad/s), spin-axis tilt (degrees) and path curvature (1/m) against the cue's "
         "sideways offset (m), -12 mm (left english) to 12 mm",
         cases=("billiard",),
-        grid={"offset_side": [-0.012, -0.006, 0.0, 0.006, 0.012]},
+        grid={"offset_side": [-0.012, 0.0, 0.012]},
         params={"elevation": 60.0},
         measures=MEASURES,
         axes=("offset_side",),
         units=UNITS,
         view="sweep",
+        full={
+            "grid": {
+                "offset_side": [-0.012, -0.009, -0.006, -0.003, 0.0, 0.003, 0.006, 0.009, 0.012]
+            }
+        },
     )
 )
 STUDIES.register(

@@ -57,7 +57,7 @@ def test_study_cells_are_deterministic():
     assert list(study.jobs()) == list(study.jobs())
 
 
-def test_rocking_block_table_has_every_law_at_nine_aspect_ratios(rocking):
+def test_rocking_block_table_has_every_law_at_five_aspect_ratios(rocking):
     frame = rocking.frame
     assert list(frame.columns) == [
         "law",
@@ -71,7 +71,7 @@ def test_rocking_block_table_has_every_law_at_nine_aspect_ratios(rocking):
     assert not frame.isna().any().any()
     assert set(frame["mu"]) == {0.0, 1.0}
     for (_, _), group in frame.groupby(["law", "mu"]):
-        np.testing.assert_allclose(group["width"], np.logspace(-1, 1, 9))
+        np.testing.assert_allclose(group["width"], np.logspace(-1, 1, 5))
     present = set(frame["law"])
     for law in lawbench.LAWS.names():
         assert law in present or any(note.startswith(f"{law}: refused") for note in rocking.notes)
@@ -79,13 +79,13 @@ def test_rocking_block_table_has_every_law_at_nine_aspect_ratios(rocking):
 
 
 def test_every_cell_has_a_verdict_of_the_taxonomy(rocking):
-    assert len(rocking.data) == 2 * 9 * len(lawbench.LAWS.names())
+    assert len(rocking.data) == 2 * 5 * len(lawbench.LAWS.names())
     assert set(rocking.data["verdict"]) <= {str(v) for v in Verdict}
 
 
 def test_a_law_that_cannot_treat_two_contacts_is_refused_with_the_reason(rocking):
     note = next(n for n in rocking.notes if n.startswith("brach:"))
-    assert "refused on 18 of 18 cells" in note and "2 closed contacts" in note
+    assert "refused on 10 of 10 cells" in note and "2 closed contacts" in note
     assert "brach" not in set(rocking.frame["law"])
 
 
@@ -262,7 +262,7 @@ def test_a_sweep_draws_each_measure_against_its_axis_per_law():
         table = collect(study.plan(laws=["moreau"]), pool)
     frame = sweeps._tidy(table, "elevation", list(study.measures), [])
     assert set(frame["law"]) == {"moreau"}
-    assert sorted(frame["elevation"]) == [0.0, 15.0, 30.0, 45.0, 60.0, 75.0]
+    assert sorted(frame["elevation"]) == list(study.grid["elevation"])
     assert {"ball_speed", "spin[wx]", "spin[wz]", "spin_tilt"} <= set(frame.columns)
     units = {**study.units, "elevation": "deg"}
     figure = sweeps._figure("billiard", study.title, frame, "elevation", units)

@@ -35,8 +35,8 @@ def decades(start: int, stop: int, step: int = 1) -> list[float]:
 def speed_accuracy(case: str, slow: bool = False) -> Study:
     """Every law on ``case`` at its defaults, its accuracy knob swept.
 
-    Cost, model error and numerical error (`lawbench.checks.measures`), three solves per point (five
-    in the full report).
+    Cost, model error and numerical error (`lawbench.checks.measures`), one solve per point (the
+    median of five in the full report).
     """
     return Study(
         name=f"{case}_speed_accuracy",
@@ -48,7 +48,6 @@ def speed_accuracy(case: str, slow: bool = False) -> Study:
             "model_error": measures.model_error,
             "numerical_error": measures.numerical_error,
         },
-        repeats=3,
         view="tradeoff",
         slow=slow,
         full={"knobs": decades(-1, -11, -1), "repeats": 5},
@@ -140,7 +139,7 @@ def energy_map(
     x: tuple[str, float, float],
     y: tuple[str, float, float],
     params: Mapping[str, Any] | None = None,
-    points: int = 7,
+    points: int = 5,
     full_points: int = 41,
 ) -> Study:
     """The energy change of every law on ``case`` over two parameters.

@@ -53,7 +53,8 @@ class Config:
         return f"lawbench report --{self.mode} --out {out}"
 
 
-QUICK = Config(mode="quick", workers=2, budget_s=60.0)
+# Quick: ten seconds a cell, so that one cell the laws cannot answer fast does not hold the page.
+QUICK = Config(mode="quick", workers=2, budget_s=10.0)
 FULL = Config(mode="full", workers=os.cpu_count() or 2, budget_s=600.0)
 
 

@@ -142,11 +142,12 @@ def _scene_blocks(case: Case, data: pd.DataFrame, repeats: int) -> list[Any]:
     fig.suptitle(case.name)
     truth = case.ground_truth
     named = f"{truth.describe()}: {truth.why}" if truth else "none declared"
+    cost = "one solve" if repeats == 1 else f"median of {repeats} solves"
     caption = (
         f"`{case.name}` at its default parameters, each law's accuracy knob swept. Left: model "
         f"error against the ground truth, {named}. Right: numerical error against the law's "
         f"own answer at its tightest knob. The ground truth's model is drawn on the right "
-        f"only: it is the reference, never a candidate. Cost: median of {repeats} solves; an "
+        f"only: it is the reference, never a candidate. Cost: {cost}; an "
         f"error of 0 (an exact law against itself) drawn at {plots.FLOOR:g}; black circles: "
         "the Pareto front of model error and cost over the laws under test."
     )
