@@ -166,7 +166,7 @@ CASES.register(Lamina())
 for study in (
     speed_accuracy("lamina"),
     large_friction("lamina"),
-    grazing("lamina", [0.0, 1.0], slow=True),
-    duplicated_contact("lamina", [0.0, 1.0], slow=True),
+    grazing("lamina", [0.0, 1.0]),
+    duplicated_contact("lamina", [0.0, 1.0]),
 ):
     STUDIES.register(study)

@@ -175,8 +175,8 @@ for study in (
         grid={"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC},
         slow=True,
     ),
-    grazing("two_balls_wall", _ELASTIC_AND_PLASTIC["e"], slow=True),
-    duplicated_contact("two_balls_wall", _ELASTIC_AND_PLASTIC["e"], slow=True),
+    grazing("two_balls_wall", _ELASTIC_AND_PLASTIC["e"]),
+    duplicated_contact("two_balls_wall", _ELASTIC_AND_PLASTIC["e"]),
 ):
     STUDIES.register(study)
 STUDIES.register(speed_accuracy("two_balls_wall"))
