@@ -9,6 +9,7 @@ of the impulse problem: the projection of ``v-`` in the kinetic metric on
 ``{w : W.T w + (E r + s, 0) in K*}``, whose multipliers are the impulses), solved with SCS.
 """
 
+import dataclasses
 import itertools
 
 import cvxpy as cp
@@ -395,3 +396,17 @@ def test_deterministic(friction):
     second = MOREAU.resolve(problem, friction=friction)
     for field in ("v_plus", "Pn", "Pt"):
         assert np.array_equal(getattr(first, field), getattr(second, field)), field
+
+
+@pytest.mark.parametrize("scale", [1e-12, 1e-6, 1e6])
+def test_a_cone_program_answers_alike_at_every_scale_of_its_velocities(scale):
+    """Moreau's law is homogeneous: velocities times s give impulses times s (Moreau 1988).
+    clarabel's tolerances are partly absolute, so the program is solved at unit magnitudes;
+    at 1e-7 m/s it had ended 'Solved' with an active contact still separating at half its
+    approach speed (an LMGC90 problem, tests/data/fclib)."""
+    problem = lawbench.CASES["bouncing_ball"].build()
+    scaled = dataclasses.replace(problem, v=problem.v * scale)
+    law = lawbench.LAWS["moreau"]
+    unit, small = law.resolve(problem), law.resolve(scaled)
+    np.testing.assert_allclose(small.v_plus / scale, unit.v_plus, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(small.Pn / scale, unit.Pn, rtol=1e-9)

@@ -88,6 +88,11 @@ def solve_cone_qp(
         When clarabel's status is not 'Solved' and its answer could not be polished.
     """
     m, size = len(mu), len(q)
+    # Scaled to unit magnitudes (by powers of two, exact): clarabel's tolerances are absolute
+    # as well as relative, and a problem whose velocities are 1e-7 m/s ended 'Solved' with its
+    # complementarity broken by half the approach speed. P = (s / g) P^ solves the scaled one.
+    g, s = _binary_scale(np.abs(G).max()), _binary_scale(np.abs(q).max())
+    G, q = G / g, q / s
     # Contact j's slack -A P is (mu_j Pn_j, Pt_j), or (Pn_j, Pt_j) when it is frictionless.
     cols, values, cones = [], [], []
     for j in range(m):
@@ -113,7 +118,15 @@ def solve_cone_qp(
         budget.current().out_of_time()
     if exact is None and status != "Solved":
         raise SolverFailure(f"clarabel status {status} after {solution.iterations} iterations")
-    return ConeResult(P if exact is None else exact, status, solution.iterations, exact is not None)
+    answer = (P if exact is None else exact) * (s / g)
+    return ConeResult(answer, status, solution.iterations, exact is not None)
+
+
+def _binary_scale(size: float) -> float:
+    """The power of two nearest ``size`` (1 for zero or a non-finite size)."""
+    if not np.isfinite(size) or size <= 0.0:
+        return 1.0
+    return float(2.0 ** np.round(np.log2(size)))
 
 
 def split(x: np.ndarray, m: int, d: int) -> tuple[np.ndarray, np.ndarray]:
