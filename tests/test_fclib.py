@@ -2,13 +2,15 @@
 
 The reader is checked against files written here with h5py in FCLIB's own layout
 (``fclib.h``/``fclib.c`` of the FCLIB library: ``/fclib_local/W`` as a sparse matrix with
-``nzmax, m, n, nz, p, i, x``; ``/fclib_local/vectors/q`` and ``mu``; ``spacedim``), so that it
-is not only held to our own writer.
+``nzmax, m, n, nz, p, i, x``; ``/fclib_local/vectors/q`` and ``mu``; ``spacedim``), and
+against global problems that Siconos and LMGC90 wrote (``tests/data/fclib``), so that it is not
+only held to our own writer.
 """
 
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,7 +30,7 @@ def fclib_local(path, W, q, mu, layout):
         m, n = W.shape
         rows, cols = np.nonzero(W)
         if layout == "triplet":
-            p, i, x, nz = rows, cols, W[rows, cols], len(rows)
+            p, i, x, nz = cols, rows, W[rows, cols], len(rows)  # fclib.h: i rows, p columns
         else:
             import scipy.sparse
 
@@ -123,4 +125,80 @@ def test_a_file_that_is_not_an_impact_problem_is_refused_by_name(tmp_path):
     with h5py.File(path, "a") as handle:
         del handle["fclib_local/vectors/q"]
     with pytest.raises(lawbench.InvalidProblem, match="vectors/q is missing"):
+        read_fclib(path)
+
+
+# Problems written by Siconos and LMGC90 (tests/data/fclib/README.md).
+FIELD = sorted((Path(__file__).parent / "data" / "fclib").glob("*.hdf5"))
+
+
+def coulomb_projection(x, mu):
+    """Projection of (xn, xt1, xt2) onto the cone |xt| <= mu xn."""
+    normal, tangent = x[0], x[1:]
+    size = float(np.linalg.norm(tangent))
+    if size <= mu * normal:
+        return x
+    if mu * size <= -normal:
+        return np.zeros(3)
+    a = (normal + mu * size) / (1 + mu * mu)
+    return np.concatenate([[a], mu * a * tangent / size])
+
+
+def triplets(group):
+    """A sparse matrix of an FCLIB file as fclib.h defines triplets: row i[k], column p[k]."""
+    import scipy.sparse
+
+    nz = int(group["nz"][()].ravel()[0])
+    shape = (int(group["m"][()].ravel()[0]), int(group["n"][()].ravel()[0]))
+    rows, columns = group["i"][()][:nz], group["p"][()][:nz]
+    return scipy.sparse.coo_matrix((group["x"][()][:nz], (rows, columns)), shape=shape).tocsr()
+
+
+@pytest.mark.parametrize("path", FIELD, ids=[p.stem for p in FIELD])
+def test_global_problems_from_siconos_and_lmgc90_are_solved_on_their_own_data(path):
+    """Acary, Brémond and Huber's measure of a frictional contact solution, the natural map of
+    De Saxce's complementarity, computed here from the file's own M, H, f, w and mu (read with
+    h5py, not with the reader under test): v+ = M^-1 (H r + f), u = H.T v+ + w, and per contact
+    r - P_K(r - (u + (mu |u_T|, 0, 0))) = 0. Moreau's law reaches it to 1e-8 relative."""
+    with h5py.File(path, "r") as handle:
+        root = handle["fclib_global"]
+        M, H = triplets(root["M"]).toarray(), triplets(root["H"])
+        vectors = {k: np.asarray(root["vectors"][k][()], dtype=float).ravel() for k in "fw"}
+        mu = np.asarray(root["vectors"]["mu"][()], dtype=float).ravel()
+    outcome = lawbench.LAWS["moreau"].resolve(read_fclib(path))
+    assert outcome.Pn.size == mu.size == H.shape[1] // 3
+    m = mu.size
+    r = np.column_stack([outcome.Pn, outcome.Pt.reshape(m, 2)]).ravel()
+    v = np.linalg.solve(M, H @ r + vectors["f"])
+    np.testing.assert_allclose(v, outcome.v_plus, rtol=1e-9, atol=1e-9 * np.abs(v).max())
+    u = H.T @ v + vectors["w"]
+    residual = []
+    for j in range(m):
+        uj, rj = u[3 * j : 3 * j + 3], r[3 * j : 3 * j + 3]
+        shifted = uj + np.array([mu[j] * np.linalg.norm(uj[1:]), 0.0, 0.0])
+        residual.append(rj - coulomb_projection(rj - shifted, mu[j]))
+    scale = max(np.abs(r).max(), np.abs(u).max())
+    assert np.abs(residual).max() <= 1e-8 * scale
+
+
+@pytest.mark.parametrize(
+    ("layout", "key", "value", "message"),
+    [
+        ("triplet", "i", 99, r"/W/i \(rows\)\[\d+\] = 99 lies outside 0\.\.5"),
+        ("triplet", "p", -1, r"/W/p \(columns\)\[\d+\] = -1 lies outside 0\.\.5"),
+        ("csc", "i", 6, r"/W/i\[\d+\] = 6 lies outside 0\.\.5"),
+        ("csc", "p", -3, r"/W/p must start at 0, never decrease"),
+    ],
+)
+def test_an_index_outside_the_matrix_is_refused_by_name(tmp_path, layout, key, value, message):
+    """A corrupt index array is refused before scipy sees it, naming the field and value."""
+    W, q, mu = random_local(np.random.default_rng(3), 2)
+    path = tmp_path / "bad.hdf5"
+    fclib_local(path, W, q, mu, layout)
+    with h5py.File(path, "r+") as handle:
+        index = handle["fclib_local/W"][key]
+        broken = index[()]
+        broken[len(broken) // 2] = value
+        index[...] = broken
+    with pytest.raises(lawbench.InvalidProblem, match=message):
         read_fclib(path)

@@ -21,7 +21,9 @@ keeping the ``k`` positive eigenvalues, with ``M = I_k``, contact Jacobian
 a ``q`` outside the range of ``W`` is refused.
 
 Matrices are read in any of FCLIB's sparse layouts (``nz = -1`` compressed columns, ``-2``
-compressed rows, ``>= 0`` triplets) and written as compressed columns. HDF5 needs h5py.
+compressed rows, ``>= 0`` triplets: row ``i[k]``, column ``p[k]``), their index arrays checked
+against the matrix's shape before scipy sees them, and written as compressed columns. HDF5
+needs h5py.
 """
 
 from __future__ import annotations
@@ -49,24 +51,65 @@ def is_fclib(path: str | Path) -> bool:
 
 
 def _read_matrix(group: Any, where: str) -> np.ndarray:
+    """A matrix in any of FCLIB's layouts, its index arrays checked against its shape first.
+
+    Triplets (``nz >= 0``) hold the row of entry k in ``i[k]`` and its column in ``p[k]``
+    (``fclib.h``; as Siconos and LMGC90 write them), repeated entries summed.
+    """
+
     def number(key: str) -> int:
         if key not in group:
             raise InvalidProblem(f"{where}/{key} is missing")
         return int(np.asarray(group[key][()]).ravel()[0])
 
     m, n, nz = number("m"), number("n"), number("nz")
-    p, i, x = (np.asarray(group[key][()]) if key in group else None for key in ("p", "i", "x"))
-    if p is None or i is None or x is None:
-        raise InvalidProblem(f"{where}: p, i and x are needed")
-    if nz == -1:
-        matrix = scipy.sparse.csc_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n))
-    elif nz == -2:
-        matrix = scipy.sparse.csr_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n))
-    elif nz >= 0:
-        matrix = scipy.sparse.coo_matrix((x[:nz], (p[:nz], i[:nz])), shape=(m, n))
-    else:
+    if m < 0 or n < 0:
+        raise InvalidProblem(f"{where}: a matrix of {m} x {n}")
+    p, i, x = (_array(group, key, where) for key in ("p", "i", "x"))
+    for key, index in (("p", p), ("i", i)):
+        if not np.issubdtype(index.dtype, np.integer):
+            raise InvalidProblem(f"{where}/{key} holds {index.dtype}, not integers")
+    if nz >= 0:
+        if min(p.size, i.size, x.size) < nz:
+            raise InvalidProblem(
+                f"{where}: nz = {nz} triplets, but p, i and x hold {p.size}, {i.size} and "
+                f"{x.size} entries"
+            )
+        rows, columns = i[:nz], p[:nz]
+        _within(rows, m, f"{where}/i (rows)")
+        _within(columns, n, f"{where}/p (columns)")
+        return scipy.sparse.coo_matrix((x[:nz], (rows, columns)), shape=(m, n)).toarray()
+    if nz not in (-1, -2):
         raise InvalidProblem(f"{where}/nz = {nz}: not an FCLIB sparse layout (-2, -1 or >= 0)")
-    return matrix.toarray()
+    major, minor, layout = (n, m, "columns") if nz == -1 else (m, n, "rows")
+    if p.size != major + 1:
+        raise InvalidProblem(
+            f"{where}/p has {p.size} entries; compressed {layout} of a {m} x {n} matrix need "
+            f"{major + 1}"
+        )
+    if p[0] != 0 or (np.diff(p) < 0).any() or p[-1] > min(i.size, x.size):
+        raise InvalidProblem(
+            f"{where}/p must start at 0, never decrease and end within i and x "
+            f"({i.size} and {x.size} entries); it runs from {p[0]} to {p[-1]}"
+        )
+    _within(i[: p[-1]], minor, f"{where}/i")
+    arrays = (x[: p[-1]], i[: p[-1]], p)
+    matrix = scipy.sparse.csc_matrix if nz == -1 else scipy.sparse.csr_matrix
+    return matrix(arrays, shape=(m, n)).toarray()
+
+
+def _array(group: Any, key: str, where: str) -> np.ndarray:
+    if key not in group:
+        raise InvalidProblem(f"{where}/{key} is missing (p, i and x are needed)")
+    return np.asarray(group[key][()]).ravel()
+
+
+def _within(index: np.ndarray, bound: int, where: str) -> None:
+    """Refuse an index array with an entry outside ``0 .. bound - 1``."""
+    outside = (index < 0) | (index >= bound)
+    if outside.any():
+        k = int(np.flatnonzero(outside)[0])
+        raise InvalidProblem(f"{where}[{k}] = {int(index[k])} lies outside 0..{bound - 1}")
 
 
 def _write_matrix(group: Any, matrix: np.ndarray) -> None:
