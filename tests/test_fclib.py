@@ -30,7 +30,12 @@ def fclib_local(path, W, q, mu, layout):
         m, n = W.shape
         rows, cols = np.nonzero(W)
         if layout == "triplet":
-            p, i, x, nz = cols, rows, W[rows, cols], len(rows)  # fclib.h: i rows, p columns
+            p, i, x, nz = (
+                cols,
+                rows,
+                W[rows, cols],
+                len(rows),
+            )  # CSparse's triplets: i rows, p columns
         else:
             import scipy.sparse
 
@@ -145,7 +150,7 @@ def coulomb_projection(x, mu):
 
 
 def triplets(group):
-    """A sparse matrix of an FCLIB file as fclib.h defines triplets: row i[k], column p[k]."""
+    """A sparse matrix of an FCLIB file in CSparse's triplets: row i[k], column p[k]."""
     import scipy.sparse
 
     nz = int(group["nz"][()].ravel()[0])
@@ -202,3 +207,17 @@ def test_an_index_outside_the_matrix_is_refused_by_name(tmp_path, layout, key, v
         index[...] = broken
     with pytest.raises(lawbench.InvalidProblem, match=message):
         read_fclib(path)
+
+
+def test_the_rolling_friction_form_is_refused_by_name(tmp_path, capsys):
+    """FCLIB's /fclib_global_rolling (fclib.h: rolling friction coefficients mu_r per contact)
+    is recognised as FCLIB and refused as a problem no impact law here treats (exit 3)."""
+    from lawbench.views import cli
+
+    path = tmp_path / "rolling.hdf5"
+    with h5py.File(path, "w") as handle:
+        handle.create_group("fclib_global_rolling").create_dataset("spacedim", data=[5])
+    with pytest.raises(lawbench.NotApplicable, match="rolling friction"):
+        read_fclib(path)
+    assert cli.main(["solve", "moreau", "--problem", str(path)]) == 3
+    assert "fclib_global_rolling" in capsys.readouterr().err

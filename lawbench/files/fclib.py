@@ -34,18 +34,21 @@ from typing import Any
 import numpy as np
 import scipy.sparse
 
-from lawbench.core.errors import InvalidProblem
+from lawbench.core.errors import InvalidProblem, NotApplicable
 from lawbench.core.problem import ImpactProblem
 from lawbench.files.hdf5 import require_h5py
 
 FORMS = ("local", "global")
+# FCLIB's forms that are not frictional impacts, by their HDF5 group: recognised, and refused.
+OTHER_FORMS = {"fclib_global_rolling": "the global problem with rolling friction"}
 
 
 def is_fclib(path: str | Path) -> bool:
-    """Whether ``path`` is an HDF5 file holding an FCLIB problem."""
+    """Whether ``path`` is an HDF5 file holding an FCLIB problem (of any form)."""
     try:
         with require_h5py().File(path, "r") as handle:
-            return any(f"fclib_{form}" in handle for form in FORMS)
+            groups = [f"fclib_{form}" for form in FORMS] + list(OTHER_FORMS)
+            return any(group in handle for group in groups)
     except OSError:
         return False
 
@@ -53,8 +56,10 @@ def is_fclib(path: str | Path) -> bool:
 def _read_matrix(group: Any, where: str) -> np.ndarray:
     """A matrix in any of FCLIB's layouts, its index arrays checked against its shape first.
 
-    Triplets (``nz >= 0``) hold the row of entry k in ``i[k]`` and its column in ``p[k]``
-    (``fclib.h``; as Siconos and LMGC90 write them), repeated entries summed.
+    Triplets (``nz >= 0``) hold the row of entry k in ``i[k]`` and its column in ``p[k]``:
+    CSparse's triplets, which Siconos and LMGC90 write (the field comments of ``fclib.h`` name
+    them the other way round; every file those programs write has ``i`` within the rows and
+    ``p`` within the columns). Repeated entries are summed.
     """
 
     def number(key: str) -> int:
@@ -155,6 +160,8 @@ def read_fclib(path: str | Path) -> ImpactProblem:
         For a file that is not FCLIB, a missing field, a form this mapping cannot represent
         (equality constraints, an offset ``w``, ``q`` outside the range of ``W``), or a bad
         field of the resulting problem; the message names the field.
+    NotApplicable
+        For FCLIB's rolling-friction form: no impact law here has rolling resistance.
     """
     where = str(path)
     try:
@@ -167,6 +174,12 @@ def read_fclib(path: str | Path) -> ImpactProblem:
         elif "fclib_local" in handle:
             root, form = handle["fclib_local"], "local"
         else:
+            for group, name in OTHER_FORMS.items():
+                if group in handle:
+                    raise NotApplicable(
+                        f"{where}: /{group} is FCLIB's {name}; the impact laws here have "
+                        "Coulomb friction only (no rolling resistance)"
+                    )
             raise InvalidProblem(f"{where}: neither /fclib_local nor /fclib_global")
         where = f"{where}:/fclib_{form}"
         dim = int(np.asarray(root["spacedim"][()]).ravel()[0]) if "spacedim" in root else 3
