@@ -58,7 +58,7 @@ def _read_matrix(group: Any, where: str) -> np.ndarray:
 
     Triplets (``nz >= 0``) hold the row of entry k in ``i[k]`` and its column in ``p[k]``:
     CSparse's triplets, which Siconos and LMGC90 write (the field comments of ``fclib.h`` name
-    them the other way round; every file those programs write has ``i`` within the rows and
+    them the other way round; in the files of theirs read here ``i`` stays within the rows and
     ``p`` within the columns). Repeated entries are summed.
     """
 
