@@ -56,6 +56,31 @@ def test_the_first_of_several_events_and_those_simultaneous_with_it():
     assert both.fired == (1, 0)
 
 
+def test_stacked_event_functions_find_the_same_event_as_one_state_at_a_time():
+    """cos t + 0.999 dips below zero for 0.09 around pi, just before sin t falls through zero
+    there: the stacked calls (one a step, the step's samples at once) meet what one call a
+    sample meets, at the same point and state."""
+
+    def events(t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        return np.stack([y[..., 0], y[..., 1] + 0.999], axis=-1)
+
+    calls = []
+
+    def counted(t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        calls.append(np.shape(y))
+        return events(t, y)
+
+    start = np.array([0.0, 1.0])
+    one = EventIntegrator(rtol=1e-12, atol=1e-14, samples=4)
+    stacked = EventIntegrator(rtol=1e-12, atol=1e-14, samples=4, stacked=True)
+    expected = one.to_event(harmonic, 0.0, start, events, -1.0)
+    found = stacked.to_event(harmonic, 0.0, start, counted, -1.0)
+    assert expected.fired == (1,) and expected.x == pytest.approx(math.acos(-0.999), rel=1e-9)
+    assert found.fired == expected.fired and found.x == expected.x
+    assert np.array_equal(found.y, expected.y)
+    assert (4, 2) in calls
+
+
 def test_no_event_before_the_end_returns_the_end_and_every_step_is_seen():
     """No event before x_end: the state there, nothing fired; the steps seen are contiguous."""
     seen = []

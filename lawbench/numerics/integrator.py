@@ -16,7 +16,7 @@ open `lawbench.core.budget.Budget` of the solve, so ``max_steps``, ``max_events`
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from functools import partial
 
@@ -64,6 +64,10 @@ class EventIntegrator:
         Whether the state returned lies just past the first change of sign (on the new
         branch), or at Brent's root of it, to rounding on either side (where a law applies
         the event's transition itself).
+    stacked : bool
+        Whether the event functions take a step's sample states at once: ``events(x, y)`` with
+        ``y`` of shape ``(samples, n)`` returns ``(samples, functions)`` (one call a step, not
+        ``samples``); a single state of shape ``(n,)`` still gives one row.
     """
 
     def __init__(
@@ -75,6 +79,7 @@ class EventIntegrator:
         simultaneous: float = 0.0,
         what: str = "integrator steps",
         past: bool = True,
+        stacked: bool = False,
     ) -> None:
         import scipy.integrate  # on first use: registering a law imports no integrator
 
@@ -82,6 +87,7 @@ class EventIntegrator:
         self.method = getattr(scipy.integrate, method)
         self.rtol, self.atol, self.samples = rtol, atol, samples
         self.simultaneous, self.what, self.past = simultaneous, what, past
+        self.stacked = stacked
 
     def to_event(
         self,
@@ -133,9 +139,8 @@ class EventIntegrator:
                 raise SolverFailure(f"{spend.law}: {self.method_name} failed: {message}")
             dense = solver.dense_output()
             start = solver.t_old
-            for x in np.linspace(solver.t_old, solver.t, self.samples + 1)[1:]:
-                y = solver.y if x == solver.t else dense(x)
-                after = np.asarray(events(x, y), dtype=float)
+            xs = np.linspace(solver.t_old, solver.t, self.samples + 1)[1:]
+            for x, after in zip(xs, self._values(events, dense, xs, solver.y), strict=True):
                 crossed = np.flatnonzero(_fires(before, after, direction))
                 if crossed.size:
                     spend.event()
@@ -147,6 +152,18 @@ class EventIntegrator:
             if on_step is not None:
                 on_step(dense, solver.t_old, solver.t)
         return Event(float(solver.t), solver.y, ())
+
+    def _values(
+        self, events: Callable, dense: Dense, xs: np.ndarray, y_end: np.ndarray
+    ) -> Iterator[np.ndarray]:
+        """The event functions at the samples ``xs`` of a step that ends at ``y_end``."""
+        if self.stacked:
+            ys = np.asarray(dense(xs)).T.copy()
+            ys[-1] = y_end
+            yield from np.asarray(events(xs, ys), dtype=float)
+            return
+        for x in xs:
+            yield np.asarray(events(x, y_end if x == xs[-1] else dense(x)), dtype=float)
 
     def _locate(
         self,

@@ -107,11 +107,13 @@ class FrictionalIntegration(Integration):
     def split(self, y: np.ndarray) -> list[np.ndarray]:
         """Gaps, stretches (m, d), normal rates, tangential rates (m, d), impulses of ``y``.
 
-        The state's last entry is the work the sliders took (J).
+        The state's last entry is the work the sliders took (J). ``y`` may stack states along
+        leading axes; each part keeps them.
         """
-        m, d = self.problem.m, self.d
-        g, s, un, ut = (y[part] for part in self.parts)
-        return [g, s.reshape(m, d), un, ut.reshape(m, d), y[self.parts[3].stop : -1]]
+        m, d, lead = self.problem.m, self.d, y.shape[:-1]
+        g, s, un, ut = (y[..., part] for part in self.parts)
+        impulses = y[..., self.parts[3].stop : -1]
+        return [g, s.reshape(*lead, m, d), un, ut.reshape(*lead, m, d), impulses]
 
     def field(
         self,
@@ -124,48 +126,53 @@ class FrictionalIntegration(Integration):
 
         ``following`` slides along the slip velocity rather than the stretch (narrow cones in
         3D). Normal forces (N), the cones' radii and growth rates and the stretches' sizes
-        (scaled), the slip speeds ``lam`` along the friction's direction, and the state's rate.
+        (scaled), the slip speeds ``lam`` along the friction's direction, and the state's rate;
+        states stacked along leading axes of ``y`` give each of these stacked the same way.
         """
-        m = self.problem.m
         g, s, un, ut, _ = self.split(y)
+        lead = g.shape[:-1]
         j = np.flatnonzero(closed)
-        Fn = np.zeros(m)
-        Fn[j] = self.forces(g[j], un[j], j)
+        Fn = np.zeros(g.shape)
+        Fn[..., j] = self.forces(g[..., j], un[..., j], j)
         radius = self.cone * np.maximum(Fn, 0.0)
-        size = np.sqrt(np.einsum("jd,jd->j", s, s))
-        direction = s / np.where(size > 0, size, 1.0)[:, None]
+        size = np.sqrt(np.einsum("...jd,...jd->...j", s, s))
+        direction = s / np.where(size > 0, size, 1.0)[..., None]
         if following is not None and following.any():
-            speed = np.sqrt(np.einsum("jd,jd->j", ut, ut))
+            speed = np.sqrt(np.einsum("...jd,...jd->...j", ut, ut))
             along = following & (speed > 0)
-            direction[along] = ut[along] / speed[along, None]
+            slip = ut / np.where(along, speed, 1.0)[..., None]
+            direction = np.where(along[..., None], slip, direction)
         Ft = -self.kt_scaled[:, None] * s
         if slipping.any():
-            Ft[slipping] = -(self.kt_scaled * radius)[slipping, None] * direction[slipping]
-        f = np.concatenate([Fn, Ft.ravel()])
+            on_cone = -(self.kt_scaled * radius)[..., None] * direction
+            Ft = np.where(slipping[:, None], on_cone, Ft)
+        f = np.concatenate([Fn, Ft.reshape(*lead, -1)], axis=-1)
         f *= self.scale
-        u_rate = self.Gc @ f
-        Fn_rate = np.zeros(m)
-        Fn_rate[j] = self.force_rate(g[j], un[j], u_rate[:m][j], j)
+        u_rate = f @ self.Gc.T
+        Fn_rate = np.zeros(g.shape)
+        Fn_rate[..., j] = self.force_rate(g[..., j], un[..., j], u_rate[..., j], j)
         cone_rate = self.cone * np.where(Fn > 0, Fn_rate, 0.0)
-        along = np.einsum("jd,jd->j", direction, ut)
+        along = np.einsum("...jd,...jd->...j", direction, ut)
         lam = along - cone_rate
         s_rate = ut * closed[:, None]
         # The sliders' power, ``mu Fn lam`` (J per unit of scaled time).
-        slid = float((radius * self.kt_scaled * lam * self.L)[slipping].sum())
+        slid = np.where(slipping, radius * self.kt_scaled * lam * self.L, 0.0).sum(axis=-1)
         if slipping.any():
             # On the cone the stretch grows with it and turns toward the slip (it does not
             # turn where it follows the slip already): ``ut - lam n`` written as the slip
             # across the stretch plus the cone's growth, so that a slip much faster than the
             # cone grows (a grazing approach) does not leave the rounding of ``lam`` in it.
-            across = ut[slipping] - along[slipping, None] * direction[slipping]
-            s_rate[slipping] = across + cone_rate[slipping, None] * direction[slipping]
+            across = ut - along[..., None] * direction
+            s_rate = np.where(slipping[:, None], across + cone_rate[..., None] * direction, s_rate)
         return {
             "Fn": Fn,
             "radius": radius,
             "cone_rate": cone_rate,
             "size": size,
             "lam": lam,
-            "rate": np.concatenate([un, s_rate.ravel(), u_rate, f, [slid]]),
+            "rate": np.concatenate(
+                [un, s_rate.reshape(*lead, -1), u_rate, f, slid[..., None]], axis=-1
+            ),
         }
 
     def closing_slides(self, y: np.ndarray, closed: np.ndarray, j: int) -> bool:
@@ -213,7 +220,7 @@ class FrictionalIntegration(Integration):
         y = np.concatenate([y, np.zeros(m + m * d + 1)])
         rtol = self.rtol
         # Four checks a step: a slip that stops and starts again within one step is still met.
-        integrator = EventIntegrator(self.method, rtol, rtol * 1e-3, samples=4)
+        integrator = EventIntegrator(self.method, rtol, rtol * 1e-3, samples=4, stacked=True)
         spend = budget.current()
         t, self.steps, events = 0.0, 0, 0
         self.peak = np.zeros(m)
@@ -338,7 +345,8 @@ class _Mode:
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         return self.integration.field(y, self.closed, self.slipping, self.following)["rate"]
 
-    def switches(self, t: float, y: np.ndarray) -> np.ndarray:
+    def switches(self, t: float | np.ndarray, y: np.ndarray) -> np.ndarray:
+        """The event functions at ``y``, one state or a step's samples stacked (see `split`)."""
         integration = self.integration
         at = integration.field(y, self.closed, self.slipping, self.following)
         g, _, un, _, _ = integration.split(y)
@@ -352,7 +360,7 @@ class _Mode:
         ]
         if self.damped:
             j = np.flatnonzero(self.closed)
-            law = np.ones(self.closed.size)
-            law[j] = integration.law_sign(g[j], un[j], j)
+            law = np.ones(g.shape)
+            law[..., j] = integration.law_sign(g[..., j], un[..., j], j)
             parts.append(np.where(integration.c > 0, law, 1.0))
-        return np.concatenate(parts)
+        return np.concatenate(parts, axis=-1)
