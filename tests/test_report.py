@@ -24,7 +24,7 @@ from lawbench.views.report.inside import QUANTITIES
 from lawbench.views.report.marks import Mark
 from lawbench.views.report.outcomes import _figure as outcomes_figure
 from lawbench.views.report.page import Figure, Legend, Section, Table, write_page
-from lawbench.views.report.plots import figure
+from lawbench.views.report.plots import figure, log_scale
 from lawbench.views.report.tradeoff import pareto
 
 SECTIONS = ("summary", "outcomes", "tradeoff", "stability", "paradoxes", "dispersion", "inside")
@@ -83,6 +83,20 @@ def test_the_pareto_front_keeps_the_points_nothing_beats():
     cost = np.array([1.0, 2.0, 3.0, 2.5])
     error = np.array([1e-2, 1e-4, 1e-6, 1e-3])
     assert pareto(cost, error).tolist() == [True, True, True, False]
+
+
+def test_log_axes_are_labelled_in_plain_text_powers_of_ten():
+    """Decades read 10⁻⁶, the multiples within a decade 2×10⁻⁶: no TeX markup to lay out."""
+    fig, axes = figure(1, 1)
+    ax = axes[0, 0]
+    ax.plot([1e-6, 1e-3], [2e-6, 8e-6])
+    log_scale(ax, "xy")
+    FigureCanvasAgg(fig).draw()
+    decades = [t.get_text() for t in ax.get_xticklabels()]
+    within = [t.get_text() for t in ax.get_yticklabels(minor=True)]
+    assert {"10⁻⁶", "10⁻⁵", "10⁻⁴", "10⁻³"} <= set(decades)
+    assert {"2×10⁻⁶", "3×10⁻⁶", "4×10⁻⁶", "6×10⁻⁶"} <= set(within)
+    assert all("$" not in label for label in decades + within)
 
 
 def test_velocities_of_different_units_never_share_an_axis():

@@ -214,7 +214,7 @@ def _spread(ax: Any, values: np.ndarray) -> None:
     if values.size == 0 or (values < 0).any() or peaks.max() <= 0:
         return
     if peaks.min() < 1e-3 * peaks.max():
-        ax.set_yscale("log")
+        plots.log_scale(ax, "y")
         ax.set_ylim(bottom=SPREAD * peaks.max())
 
 

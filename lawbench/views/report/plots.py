@@ -1,14 +1,17 @@
-"""Shared figure helpers: figures without pyplot, law styles, log floors, units and labels."""
+"""Shared figure helpers: figures without pyplot, law styles, log axes, units and labels."""
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from matplotlib import colormaps
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogFormatter
 
 from lawbench.core.law import LAWS
 
@@ -16,6 +19,30 @@ UNIT = re.compile(r"[\[(]([^\])]+)[\])]\s*$")
 # Exact zeros (an exact law against itself, no steps) are drawn at this floor on log axes.
 FLOOR = 1e-17
 MARKERS = "osD^v<>phP*X"
+SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+class PowersOfTen(LogFormatter):
+    """Log-axis tick labels in plain text with superscript exponents: 10⁻⁶, 2×10⁻⁶.
+
+    Matplotlib's default labels are TeX-like, and laying them out took most of a report figure's
+    drawing time.
+    """
+
+    def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
+        exponent = math.floor(math.log10(x) + 1e-9)
+        coefficient = round(x / 10.0**exponent)
+        power = "10" + str(exponent).translate(SUPERSCRIPTS)
+        return power if coefficient == 1 else f"{coefficient}×{power}"
+
+
+def log_scale(ax: Axes, axes: str) -> None:
+    """Put the ``axes`` of ``ax`` ('x', 'y' or 'xy') on a log scale labelled by `PowersOfTen`."""
+    for name in axes:
+        getattr(ax, f"set_{name}scale")("log")
+        axis = ax.xaxis if name == "x" else ax.yaxis
+        axis.set_major_formatter(PowersOfTen(10.0))
+        axis.set_minor_formatter(PowersOfTen(10.0, labelOnlyBase=False))
 
 
 def figure(rows: int, cols: int, width: float = 4.2, height: float = 3.2) -> tuple[Figure, Any]:

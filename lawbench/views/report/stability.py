@@ -157,7 +157,8 @@ def _errors_figure(frame: pd.DataFrame) -> Figure:
                 linestyle="none",
             )
         ax.set_xticks(range(len(laws)), laws, rotation=45, ha="right")
-        ax.set(yscale="log", ylabel=f"{name}, dimensionless")
+        plots.log_scale(ax, "y")
+        ax.set(ylabel=f"{name}, dimensionless")
         ax.set_ylim(bottom=plots.FLOOR / 10)
     data = frame[["law", "row", "value", "momentum", "energy", "verdict"]]
     return Figure(

@@ -201,7 +201,7 @@ def _figure(
             style["linestyle"] = DASHES[variants.index(values) % len(DASHES)]
             ax.plot(ordered[axis], shown, **style)
         if _decades(frame[axis]) >= 2:
-            ax.set_xscale("log")
+            plots.log_scale(ax, "x")
         ax.set_xlabel(unit_label(axis, units))
         ax.set_ylabel(unit_label(column, units))
         ax.set_title(column)

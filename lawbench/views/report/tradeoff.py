@@ -124,7 +124,8 @@ def _scene_blocks(case: Case, data: pd.DataFrame, repeats: int) -> list[Any]:
         for law, group in known.groupby("law", sort=False):
             floored = plots.floored(group[measure].astype(float))
             ax.plot(group["wall_time_s"], floored, linestyle="-", **plots.law_style(law))
-        ax.set(xscale="log", yscale="log", xlabel="median wall time [s]", ylabel=label)
+        plots.log_scale(ax, "xy")
+        ax.set(xlabel="median wall time [s]", ylabel=label)
         ax.set_ylim(bottom=plots.FLOOR / 10)
     data["pareto"] = False
     known = measured[measured["model_error"].notna() & measured["candidate"]]
