@@ -142,3 +142,44 @@ def test_a_cell_pays_for_its_perturbed_solves_once(monkeypatch):
     jumps(trial, (1e-2,))
     jumps(lawbench.evaluate("newton", "three_ball_chain"), (1e-2, 1e-4))
     assert len(calls) > solved + solved // 2
+
+
+def test_a_perturbed_solve_has_a_budget_in_proportion_to_the_original(monkeypatch):
+    """A perturbed problem is the size of the original: its solve gets PERTURBED_RATIO times the
+    original's wall time, within [PERTURBED_FLOOR_S, PERTURBED_SECONDS]."""
+    from lawbench.checks import continuity
+
+    trial = lawbench.evaluate("newton", "three_ball_chain")
+    law = type(trial.law)
+    limits = []
+    resolve = law.resolve
+    monkeypatch.setattr(
+        law,
+        "resolve",
+        lambda self, *a, **k: limits.append(k.get("max_seconds")) or resolve(self, *a, **k),
+    )
+    for spent, expected in ((1e-4, continuity.PERTURBED_FLOOR_S), (0.1, 2.0), (10.0, 5.0)):
+        trial.outcome.diagnostics["wall_time_s"] = spent
+        limits.clear()
+        continuity._jumps(trial, (1e-2,))
+        assert limits and all(limit == pytest.approx(expected) for limit in limits)
+
+
+def test_a_ground_truth_and_a_tightest_knob_naming_the_same_options_are_solved_once(
+    monkeypatch,
+):
+    """Re-solves are kept under the law's complete options: {'tol': 1e-12} and every option
+    spelled out at those values are one answer."""
+    from lawbench.checks import measures
+
+    problem = lawbench.CASES.get("three_ball_chain").build()
+    law = lawbench.LAWS.get("compliant")
+    calls = []
+    resolve = type(law).resolve
+    monkeypatch.setattr(
+        type(law), "resolve", lambda self, *a, **k: calls.append(1) or resolve(self, *a, **k)
+    )
+    monkeypatch.setattr(measures, "_SOLVED", {})
+    short = measures._solve("compliant", {"tol": 1e-9}, problem)
+    spelled = measures._solve("compliant", law.option_values({"tol": 1e-9}), problem)
+    assert len(calls) == 1 and np.array_equal(short, spelled)

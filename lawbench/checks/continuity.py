@@ -10,8 +10,10 @@ the gaps event by event (`lawbench.checks.gaps.resolve_with_gaps`). The value is
 that remains at the smallest size, relative to the largest velocity; continuous when it is
 below 1e-3. The detail gives the jumps per size and the kinetic angles between the contacts,
 which by Paoli's condition (Brogliato 2010, 'kinetic angle and continuity') predict where rigid
-laws must be discontinuous: angles other than 90 degrees with e > 0. Each perturbed solve has
-at most `PERTURBED_SECONDS` of wall-clock time; one that runs out refuses the check with why.
+laws must be discontinuous: angles other than 90 degrees with e > 0. A perturbed problem is the
+size of the original, so each perturbed solve has `PERTURBED_RATIO` times the original's
+wall-clock time (at least `PERTURBED_FLOOR_S`, at most `PERTURBED_SECONDS`); one that runs out
+refuses the check with why.
 """
 
 from __future__ import annotations
@@ -29,8 +31,11 @@ from lawbench.core.trial import Trial
 
 SIZES = (1e-2, 1e-4, 1e-6)
 CONTINUOUS = 1e-3
-# Wall-clock budget of each perturbed solve (s): a perturbed problem is the size of the
-# original, and one the law cannot solve in this time leaves the check without its premise.
+# Wall-clock budget of each perturbed solve: PERTURBED_RATIO times the original solve's, within
+# [PERTURBED_FLOOR_S, PERTURBED_SECONDS] (s). A law that needs more on a problem a millionth away
+# from one it solved leaves the check without its premise.
+PERTURBED_RATIO = 20.0
+PERTURBED_FLOOR_S = 0.5
 PERTURBED_SECONDS = 5.0
 
 
@@ -70,7 +75,12 @@ def jumps(trial: Trial, sizes: tuple[float, ...] = SIZES) -> dict[str, list[floa
 
 def _jumps(trial: Trial, sizes: tuple[float, ...]) -> dict[str, list[float]]:
     problem, law = trial.problem, trial.law
-    limit = min(float(trial.options.get("max_seconds", PERTURBED_SECONDS)), PERTURBED_SECONDS)
+    spent = float(trial.outcome.diagnostics.get("wall_time_s", 0.0))
+    limit = min(
+        float(trial.options.get("max_seconds", PERTURBED_SECONDS)),
+        PERTURBED_SECONDS,
+        max(PERTURBED_FLOOR_S, PERTURBED_RATIO * spent),
+    )
     options = {**trial.options, "max_seconds": limit}
     base = trial.outcome.v_plus
     scale = float(np.abs(problem.v).max())

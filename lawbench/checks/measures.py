@@ -49,11 +49,16 @@ def _digest(problem: ImpactProblem) -> str:
 
 
 def _solve(law: str, options: dict[str, Any], problem: ImpactProblem) -> np.ndarray | None:
-    """``law``'s post-impact velocity on ``problem``, once per process; None when it fails."""
-    key = json.dumps([law, options, _digest(problem)], sort_keys=True, default=str)
+    """``law``'s post-impact velocity on ``problem``, once per process; None when it fails.
+
+    Answers are kept under the law's complete options, so a ground truth and a law's tightest
+    knob that name the same options differently are solved once.
+    """
+    values = LAWS.get(law).option_values(options)
+    key = json.dumps([law, values, _digest(problem)], sort_keys=True, default=str)
     if key not in _SOLVED:
         try:
-            _SOLVED[key] = LAWS.get(law).resolve(problem, **options).v_plus
+            _SOLVED[key] = LAWS.get(law).resolve(problem, **values).v_plus
         except LawbenchError:
             _SOLVED[key] = None
     return _SOLVED[key]
