@@ -151,7 +151,7 @@ for study in (
         "stiffness ratio (contact 1 over contact 0)",
         "three_ball_chain",
         "stiffness_ratio",
-        grid={"stiffness_ratio": decades(-6, 6, 3), **_ELASTIC_AND_PLASTIC},
+        grid={"stiffness_ratio": decades(-6, 6, 6), **_ELASTIC_AND_PLASTIC},
         full={"grid": {"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC}},
     ),
     extremes(

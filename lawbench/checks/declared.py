@@ -90,10 +90,15 @@ def extremes(
     )
 
 
-def grazing(case: str, e: Sequence[Any], slow: bool = False) -> Study:
+def grazing(
+    case: str,
+    e: Sequence[Any],
+    values: Sequence[float] = tuple(decades(-4, -12, -4)),
+    slow: bool = False,
+) -> Study:
     """Every law on ``case`` with its approach made grazing, for each restitution of ``e``.
 
-    Fastest approach 1e-4, 1e-8 and 1e-12 m/s (every decade from 1 to 1e-12 in the full
+    Fastest approach at each of ``values`` (m/s; every decade from 1 to 1e-12 in the full
     report), the motion the contacts do not see kept (`lawbench.numerics.transforms.grazing`).
     """
     return extremes(
@@ -103,7 +108,7 @@ def grazing(case: str, e: Sequence[Any], slow: bool = False) -> Study:
         "transform",
         grid={"e": list(e)},
         transform="grazing",
-        values=decades(-4, -12, -4),
+        values=values,
         full={"transform_values": decades(0, -12, -1)},
         slow=slow,
     )
@@ -139,7 +144,7 @@ def energy_map(
     x: tuple[str, float, float],
     y: tuple[str, float, float],
     params: Mapping[str, Any] | None = None,
-    points: int = 5,
+    points: int = 4,
     full_points: int = 41,
 ) -> Study:
     """The energy change of every law on ``case`` over two parameters.
