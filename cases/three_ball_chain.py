@@ -151,7 +151,7 @@ for study in (
         "stiffness ratio (contact 1 over contact 0)",
         "three_ball_chain",
         "stiffness_ratio",
-        grid={"stiffness_ratio": decades(-6, 6, 6), **_ELASTIC_AND_PLASTIC},
+        grid={"stiffness_ratio": decades(-4, 4, 4), **_ELASTIC_AND_PLASTIC},
         full={"grid": {"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC}},
     ),
     extremes(
@@ -167,7 +167,7 @@ for study in (
     speed_accuracy("three_ball_chain"),
     energy_shares(
         "three_ball_chain",
-        decades(-3, 3),
+        decades(-3, 3, 2),
         np.logspace(-3, 3, 25).tolist(),
         name="dispersion",
     ),

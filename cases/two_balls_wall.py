@@ -165,7 +165,7 @@ CASES.register(TwoBallsWall())
 
 _ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
 for study in (
-    energy_shares("two_balls_wall", decades(-3, 3), np.logspace(-3, 3, 25).tolist()),
+    energy_shares("two_balls_wall", decades(-3, 3, 2), np.logspace(-3, 3, 25).tolist()),
     continuity("two_balls_wall"),
     extremes(
         "two_balls_wall_stiffness",
