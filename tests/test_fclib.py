@@ -90,6 +90,7 @@ def test_moreau_solves_the_fclib_local_problem(tmp_path, layout, contacts):
 
 
 @pytest.mark.parametrize("case", ["rocking_block", "sphere_wall", "bouncing_ball"])
+@pytest.mark.filterwarnings("ignore::lawbench.LossyExport")
 def test_local_and_global_round_trips(tmp_path, case):
     problem = lawbench.CASES.get(case).build()
     local = read_fclib(write_fclib(problem, tmp_path / "local.h5", "local"))
@@ -221,3 +222,26 @@ def test_the_rolling_friction_form_is_refused_by_name(tmp_path, capsys):
         read_fclib(path)
     assert cli.main(["solve", "moreau", "--problem", str(path)]) == 3
     assert "fclib_global_rolling" in capsys.readouterr().err
+
+
+def test_exporting_a_restitution_warns_that_fclib_holds_none(tmp_path, capsys):
+    """FCLIB's problems are impacts with e = 0 (fclib.h stores W, q, mu and no restitution): a
+    scene with a restitution coefficient is written as its plastic impact, and says so, in the
+    API (a LossyExport warning) and on the command line (one line on stderr, exit 0)."""
+    import warnings
+
+    from lawbench.views import cli
+
+    case = lawbench.CASES.get("sphere_wall")
+    with pytest.warns(lawbench.LossyExport, match=r"plastic impact .* contacts \[0\] are left out"):
+        write_fclib(case.build(e=1.0, e_t=0.0), tmp_path / "elastic.h5")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        write_fclib(case.build(e=0.0, e_t=0.0), tmp_path / "plastic.h5")
+    with pytest.warns(lawbench.LossyExport, match="restitution"):
+        write_fclib(case.build(e=0.0, e_t=0.5), tmp_path / "tangential.h5")
+    out = tmp_path / "cli.h5"
+    assert cli.main(["export", "sphere_wall", "--fclib", "local", "-o", str(out)]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("lawbench: warning: FCLIB holds no restitution")
+    assert read_fclib(out).m == 1

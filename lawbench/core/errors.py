@@ -35,6 +35,10 @@ class SolverFailure(LawbenchError):
     """A numerical method failed; the message gives the solver's status or the count reached."""
 
 
+class LossyExport(UserWarning):
+    """A file format cannot hold part of a problem; the message names what is left out."""
+
+
 class BudgetExceeded(SolverFailure):
     """A numerical method ran out of a named budget before it finished.
 

@@ -28,13 +28,14 @@ needs h5py.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import scipy.sparse
 
-from lawbench.core.errors import InvalidProblem, NotApplicable
+from lawbench.core.errors import InvalidProblem, LossyExport, NotApplicable
 from lawbench.core.problem import ImpactProblem
 from lawbench.files.hdf5 import require_h5py
 
@@ -238,7 +239,9 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
     """Write ``problem`` as an FCLIB file: its contact Delassus matrix (local) or M, H (global).
 
     The restitution coefficients are not part of FCLIB (its problems are impacts with
-    ``e = 0``); a frictionless problem is written with spatial dimension 2 and ``mu = 0``.
+    ``e = 0``): a problem with a nonzero one is written as its plastic impact, with a
+    `LossyExport` warning naming the contacts. A frictionless problem is written with spatial
+    dimension 2 and ``mu = 0``.
 
     Raises
     ------
@@ -248,6 +251,15 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
     if form not in FORMS:
         raise InvalidProblem(f"FCLIB form {form!r}: must be one of {', '.join(FORMS)}")
     path = Path(path)
+    restituted = [j for j, c in enumerate(problem.contacts) if _restitutes(c)]
+    if restituted:
+        shown = ", ".join(map(str, restituted[:10])) + (", ..." if len(restituted) > 10 else "")
+        warnings.warn(
+            f"FCLIB holds no restitution: {path} holds the plastic impact (e = 0); the "
+            f"restitution coefficients of contacts [{shown}] are left out",
+            LossyExport,
+            stacklevel=2,
+        )
     if problem.Wt is None:
         W = np.zeros((problem.n, 2 * problem.m))
         W[:, 0::2] = problem.Wn
@@ -272,3 +284,9 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
             vectors.create_dataset("f", data=problem.M @ problem.v)
             vectors.create_dataset("w", data=np.zeros(W.shape[1]))
     return path
+
+
+def _restitutes(contact: Any) -> bool:
+    """Whether a contact has a nonzero normal or tangential restitution coefficient."""
+    given = (contact.e, contact.e_newton, contact.e_poisson, contact.e_energy, contact.e_t)
+    return any(value for value in given if value is not None)

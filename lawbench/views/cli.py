@@ -13,6 +13,7 @@ import json
 import logging
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -20,7 +21,13 @@ from lawbench.checks import run_checks
 from lawbench.checks.declared import STUDIES
 from lawbench.checks.study import Job
 from lawbench.core.case import CASES, Case
-from lawbench.core.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
+from lawbench.core.errors import (
+    InvalidProblem,
+    LawbenchError,
+    LossyExport,
+    NotApplicable,
+    SolverFailure,
+)
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import evaluate
@@ -202,10 +209,15 @@ def _export(args: argparse.Namespace) -> None:
     from lawbench.files.problem_files import save_problem
 
     problem = CASES.get(args.case).build(**_assignments(args.set, "--set"))
-    if args.fclib:
-        path = write_fclib(problem, args.out, args.fclib)
-    else:
-        path = save_problem(problem, args.out)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", LossyExport)
+        if args.fclib:
+            path = write_fclib(problem, args.out, args.fclib)
+        else:
+            path = save_problem(problem, args.out)
+    for warning in caught:
+        if issubclass(warning.category, LossyExport):
+            print(f"lawbench: warning: {warning.message}", file=sys.stderr)
     print(f"problem written to {path}")
 
 
