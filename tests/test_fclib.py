@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.files.fclib import read_fclib, write_fclib
+from lawbench.files.fclib import fclib_diagnostics, read_fclib, write_fclib
 
 h5py = pytest.importorskip("h5py")
 
@@ -185,6 +185,36 @@ def test_global_problems_from_siconos_and_lmgc90_are_solved_on_their_own_data(pa
         residual.append(rj - coulomb_projection(rj - shifted, mu[j]))
     scale = max(np.abs(r).max(), np.abs(u).max())
     assert np.abs(residual).max() <= 1e-8 * scale
+    assert fclib_diagnostics(path, outcome)["fc3d_error"] <= 1e-8
+
+
+def test_the_fc3d_error_is_measured_on_the_files_own_asymmetric_w(tmp_path):
+    """A local file whose W is not symmetric is solved on W's symmetric part; the diagnostics
+    give the asymmetry and the FC3D error on the file's own W, which the symmetric answer
+    misses by the asymmetry's order (Siconos' fc3d_compute_error: 2-norm of the natural map
+    over max(|q|, |r|, |u|)). On the command line the JSON carries both."""
+    W, q, mu = random_local(np.random.default_rng(11), 3)
+    skew = np.triu(np.full_like(W, 1e-4), 1)
+    fclib_local(tmp_path / "sym.hdf5", W, q, mu, "csc")
+    fclib_local(tmp_path / "asym.hdf5", W + skew - skew.T, q, mu, "csc")
+    symmetric = fclib_diagnostics(
+        tmp_path / "sym.hdf5", lawbench.solve("moreau", read_fclib(tmp_path / "sym.hdf5"))
+    )
+    assert symmetric["W_asymmetry"] == 0.0 and symmetric["fc3d_error"] <= 1e-10
+    outcome = lawbench.solve("moreau", read_fclib(tmp_path / "asym.hdf5"))
+    found = fclib_diagnostics(tmp_path / "asym.hdf5", outcome)
+    assert found["W_asymmetry"] == pytest.approx(2e-4 / np.abs(W + skew - skew.T).max())
+    assert 1e-7 < found["fc3d_error"] < 1e-2
+    done = subprocess.run(
+        [sys.executable, "-m", "lawbench", "solve", "moreau", "--problem", "asym.hdf5", "--json"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["diagnostics"]["fc3d_error"] == pytest.approx(
+        found["fc3d_error"]
+    )
 
 
 @pytest.mark.parametrize(

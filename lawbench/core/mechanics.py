@@ -1,4 +1,4 @@
-"""Shared mechanics at a frozen configuration: energy, impulses to velocities, gap rates."""
+"""Shared mechanics at a frozen configuration: energy, impulses, gap rates, Coulomb cones."""
 
 from __future__ import annotations
 
@@ -94,3 +94,39 @@ def for_products(A: np.ndarray) -> np.ndarray | scipy.sparse.csr_matrix:
     if A.shape[0] > SPARSE_PRODUCTS and np.count_nonzero(A) <= SPARSE_SHARE * A.size:
         return scipy.sparse.csr_matrix(A)
     return A
+
+
+def project(Pn: float, Pt: np.ndarray, mu: float) -> tuple[float, np.ndarray]:
+    """Euclidean projection of ``(Pn, Pt)`` on the cone ``|Pt| <= mu Pn``."""
+    if mu == 0:
+        return max(Pn, 0.0), np.zeros_like(Pt)
+    norm = float(np.linalg.norm(Pt))
+    if norm <= mu * Pn:
+        return Pn, Pt
+    if mu * norm <= -Pn:
+        return 0.0, np.zeros_like(Pt)
+    normal = (Pn + mu * norm) / (1.0 + mu * mu)
+    return normal, mu * normal * Pt / norm
+
+
+def fc3d_error(W: np.ndarray, q: np.ndarray, mu: np.ndarray, r: np.ndarray) -> float:
+    """The FC3D error of a local frictional contact answer ``r`` (Acary, Brémond, Huber 2018).
+
+    ``W``, ``q`` and ``r`` in FCLIB's local order (per contact: normal, then its tangents);
+    ``u = W r + q``. The natural map of De Saxce's complementarity, per contact
+    ``r_j - P_K(r_j - (u_j + (mu_j |u_Tj|, 0...)))``, in 2-norm over every contact, relative to
+    the largest of ``|q|``, ``|r|`` and ``|u|`` (Siconos' ``fc3d_compute_error``). Zero exactly
+    at a solution.
+    """
+    dim = r.size // len(mu)
+    u = (W @ r + q).reshape(-1, dim)
+    rj = r.reshape(-1, dim)
+    x = rj - u
+    x[:, 0] -= mu * np.linalg.norm(u[:, 1:], axis=1)
+    gap = np.empty_like(rj)
+    for j, (xj, mj) in enumerate(zip(x, mu, strict=True)):
+        normal, tangent = project(float(xj[0]), xj[1:], float(mj))
+        gap[j, 0], gap[j, 1:] = rj[j, 0] - normal, rj[j, 1:] - tangent
+    error = float(np.linalg.norm(gap))
+    scale = max(float(np.linalg.norm(q)), float(np.linalg.norm(r)), float(np.linalg.norm(u)))
+    return error / scale if scale > np.finfo(float).eps else error

@@ -18,7 +18,9 @@ offset ``w`` has no counterpart in an impact problem and is refused. The local f
 generalized coordinates: they are built from the eigendecomposition ``W = V diag(l) V.T``,
 keeping the ``k`` positive eigenvalues, with ``M = I_k``, contact Jacobian
 ``Wc = diag(sqrt(l)) V.T`` (so ``Wc.T Wc = W``, singular ``W`` included) and ``v- = Wc^+ q``;
-a ``q`` outside the range of ``W`` is refused.
+a ``q`` outside the range of ``W`` is refused. A Delassus matrix is symmetric: the factorization
+takes ``W``'s symmetric part, and `fclib_diagnostics` gives the file's asymmetry and the FC3D
+error of an answer on the file's own ``W`` and ``q``, the measure of the field's comparisons.
 
 Matrices are read in any of FCLIB's sparse layouts (``nz = -1`` compressed columns, ``-2``
 compressed rows, ``>= 0`` triplets: row ``i[k]``, column ``p[k]``), their index arrays checked
@@ -29,6 +31,8 @@ needs h5py.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +40,8 @@ import numpy as np
 import scipy.sparse
 
 from lawbench.core.errors import InvalidProblem, LossyExport, NotApplicable
+from lawbench.core.mechanics import fc3d_error
+from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.files.hdf5 import require_h5py
 
@@ -152,18 +158,9 @@ def _local_order(problem: ImpactProblem) -> np.ndarray:
     )
 
 
-def read_fclib(path: str | Path) -> ImpactProblem:
-    """Read an FCLIB file (local or global form) as an impact problem with ``e = 0``.
-
-    Raises
-    ------
-    InvalidProblem
-        For a file that is not FCLIB, a missing field, a form this mapping cannot represent
-        (equality constraints, an offset ``w``, ``q`` outside the range of ``W``), or a bad
-        field of the resulting problem; the message names the field.
-    NotApplicable
-        For FCLIB's rolling-friction form: no impact law here has rolling resistance.
-    """
+@contextmanager
+def _opened(path: str | Path) -> Iterator[tuple[Any, str, str, int]]:
+    """The open file's problem group, its form, its name for messages and its ``spacedim``."""
     where = str(path)
     try:
         handle = require_h5py().File(path, "r")
@@ -188,6 +185,22 @@ def read_fclib(path: str | Path) -> ImpactProblem:
             raise InvalidProblem(f"{where}/spacedim = {dim}: must be 2 or 3")
         if "vectors" not in root:
             raise InvalidProblem(f"{where}/vectors is missing")
+        yield root, form, where, dim
+
+
+def read_fclib(path: str | Path) -> ImpactProblem:
+    """Read an FCLIB file (local or global form) as an impact problem with ``e = 0``.
+
+    Raises
+    ------
+    InvalidProblem
+        For a file that is not FCLIB, a missing field, a form this mapping cannot represent
+        (equality constraints, an offset ``w``, ``q`` outside the range of ``W``), or a bad
+        field of the resulting problem; the message names the field.
+    NotApplicable
+        For FCLIB's rolling-friction form: no impact law here has rolling resistance.
+    """
+    with _opened(path) as (root, form, where, dim):
         vectors = root["vectors"]
         mu = _vector(vectors, "mu", f"{where}/vectors")
         if form == "global":
@@ -233,6 +246,38 @@ def _coordinates(W: np.ndarray, q: np.ndarray, where: str) -> tuple[np.ndarray, 
     if np.abs(Wc.T @ v - q).max() > 1e-9 * max(np.abs(q).max(), 1e-300):
         raise InvalidProblem(f"{where}/vectors/q lies outside the range of W")
     return np.eye(int(keep.sum())), Wc, v
+
+
+def fclib_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
+    """How ``outcome`` answers the FCLIB problem of ``path``, on the file's own data.
+
+    ``fc3d_error``: Acary, Brémond and Huber's measure (`lawbench.core.mechanics.fc3d_error`)
+    on the file's ``W`` and ``q`` (global form: ``W = H.T M^-1 H``, ``q = H.T M^-1 f + w``),
+    with ``r`` the outcome's impulses in the file's local order. For the local form also
+    ``W_asymmetry``, ``max |W - W.T| / max |W|``: the impact problem read from the file keeps
+    ``W``'s symmetric part, so an answer exact on it is off by that order on the file's ``W``.
+    """
+    with _opened(path) as (root, form, where, dim):
+        vectors = root["vectors"]
+        mu = _vector(vectors, "mu", f"{where}/vectors")
+        if form == "local":
+            W = _read_matrix(root["W"], f"{where}/W")
+            q = _vector(vectors, "q", f"{where}/vectors")
+        else:
+            M = _read_matrix(root["M"], f"{where}/M")
+            H = _read_matrix(root["H"], f"{where}/H")
+            W = H.T @ _solve(M, H, where)
+            q = H.T @ _solve(M, _vector(vectors, "f", f"{where}/vectors"), where)
+            q = q + _vector(vectors, "w", f"{where}/vectors")
+    m = mu.size
+    r = np.zeros((m, dim))
+    r[:, 0] = outcome.Pn
+    if outcome.Pt.size:
+        r[:, 1:] = outcome.Pt.reshape(m, dim - 1)
+    found = {"fc3d_error": fc3d_error(W, q, mu, r.ravel())}
+    if form == "local":
+        found["W_asymmetry"] = float(np.abs(W - W.T).max() / max(np.abs(W).max(), 1e-300))
+    return found
 
 
 def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -> Path:

@@ -39,6 +39,7 @@ import numpy as np
 import scipy.sparse
 
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.outcome import Outcome
 from lawbench.core.problem import Contact, ImpactProblem, is_sparse
 from lawbench.files.hdf5 import require_h5py
 
@@ -151,6 +152,21 @@ def load_problem(path: str | Path) -> ImpactProblem:
     except (ValueError, KeyError, TypeError, zipfile.BadZipFile) as exc:
         raise InvalidProblem(f"{path}: not a lawbench problem file ({exc})") from None
     return from_dict(data, str(path))
+
+
+def file_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
+    """What a problem file's own data says of ``outcome``.
+
+    For an FCLIB file its FC3D error (`lawbench.files.fclib.fclib_diagnostics`); nothing for
+    lawbench's own formats, which hold the problem exactly as it is solved.
+    """
+    path = Path(path)
+    if _codec(path)[1] is _read_hdf5:
+        from lawbench.files.fclib import fclib_diagnostics, is_fclib
+
+        if is_fclib(path):
+            return fclib_diagnostics(path, outcome)
+    return {}
 
 
 def _json_default(value: Any) -> Any:

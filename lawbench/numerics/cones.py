@@ -31,6 +31,7 @@ import scipy.sparse
 
 from lawbench.core import budget
 from lawbench.core.errors import SolverFailure
+from lawbench.core.mechanics import project
 from lawbench.numerics.solvers import clarabel_settings
 
 NEWTON_STEPS = 30
@@ -147,19 +148,6 @@ def modified_velocity(
         m = len(mu)
         u[:m] += mu * np.linalg.norm(split(u, m, d)[1], axis=1)
     return u
-
-
-def project(Pn: float, Pt: np.ndarray, mu: float) -> tuple[float, np.ndarray]:
-    """Euclidean projection of ``(Pn, Pt)`` on the cone ``|Pt| <= mu Pn``."""
-    if mu == 0:
-        return max(Pn, 0.0), np.zeros_like(Pt)
-    norm = float(np.linalg.norm(Pt))
-    if norm <= mu * Pn:
-        return Pn, Pt
-    if mu * norm <= -Pn:
-        return 0.0, np.zeros_like(Pt)
-    normal = (Pn + mu * norm) / (1.0 + mu * mu)
-    return normal, mu * normal * Pt / norm
 
 
 def residual(

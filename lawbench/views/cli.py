@@ -230,6 +230,10 @@ def _solve(args: argparse.Namespace) -> None:
         else:
             trial = evaluate(args.law, apply(args.transform or "", case), options)
         record = trial_record(trial, run_checks(trial))
+    if args.problem is not None:
+        from lawbench.files.problem_files import file_diagnostics
+
+        record["diagnostics"].update(file_diagnostics(args.problem, trial.outcome))
     if args.json:
         print(json.dumps(record, indent=2, allow_nan=False))
         return
@@ -244,6 +248,8 @@ def _solve(args: argparse.Namespace) -> None:
         print("Pt: " + ", ".join(f"{p:.6g}" for p in record["Pt"]))
     print(f"T_minus = {record['T_minus']:.6g} J, T_plus = {record['T_plus']:.6g} J")
     print(f"formulation: {record['diagnostics'].get('formulation')}")
+    if "fc3d_error" in record["diagnostics"]:
+        print(f"FC3D error on the file's own W and q: {record['diagnostics']['fc3d_error']:.3g}")
     for name, result in record["checks"].items():
         print(f"  {name:<14}{result['verdict']:<19}{result['detail']}")
         if result["claim"]:
