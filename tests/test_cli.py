@@ -482,3 +482,72 @@ def test_describe_names_every_scenes_ground_truth():
             f"ground truth: {truth.describe()}: {truth.why}" if truth else "ground truth: none"
         )
         assert line == expected
+
+
+# Paths a careless or hostile user gives: a FIFO blocks whoever opens it, so each must be refused
+# from its status alone, before anything opens it (the test would hang otherwise).
+FIFO_COMMANDS = [
+    (["solve", "newton", "--problem", "{fifo}.json"], "problem file"),
+    (["solve", "moreau", "--problem", "{fifo}.h5"], "problem file"),
+    (["run", "{fifo}.toml"], "spec"),
+    (["fit", "newton", "three_ball_chain", "--data", "{fifo}.csv", "--free", "e"], "data"),
+    (["export", "three_ball_chain", "-o", "{fifo}.json"], "problem file"),
+    (["export", "three_ball_chain", "--fclib", "local", "-o", "{fifo}.h5"], "FCLIB file"),
+    (["run", "--laws", "newton", "--cases", "three_ball_chain", "--out", "{fifo}.csv"], "run"),
+    (["study", "rocking_block", "--out", "{fifo}.parquet"], "table"),
+]
+
+
+@pytest.mark.parametrize(("argv", "what"), FIFO_COMMANDS, ids=lambda x: " ".join(x[:2]))
+def test_a_fifo_or_a_directory_is_refused_before_it_is_opened(tmp_path, capsys, argv, what):
+    """Every file a command reads or writes must be a regular file (or a new one, to write):
+    a FIFO and a directory are refused with exit 2, naming the argument's role and the kind."""
+    import os
+
+    for suffix in (".json", ".h5", ".toml", ".csv", ".parquet"):
+        os.mkfifo(tmp_path / f"p{suffix}")
+        (tmp_path / f"d{suffix}").mkdir()
+    for name, kind in (("p", "a FIFO"), ("d", "a directory")):
+        given = [a.format(fifo=tmp_path / name) for a in argv]
+        assert cli.main(given) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and what in err[0] and kind in err[0], err
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["solve", "newton", "three_ball_chain", "--max-seconds", value]
+        for value in ("-1", "0", "nan", "inf", "1e20", "soon")
+    ]
+    + [
+        ["run", "--laws", "newton", "--cases", "three_ball_chain", "--workers", "100000"],
+        ["run", "--laws", "newton", "--cases", "three_ball_chain", "--workers", "0"],
+        ["run", "--laws", "newton", "--cases", "three_ball_chain", "--chunk-size", "0"],
+        ["run", "--laws", "newton", "--cases", "three_ball_chain", "--max-seconds", "-5"],
+        ["run", "--laws", "newton", "--cases", "three_ball_chain", "--seed", "-1"],
+        ["study", "rocking_block", "--max-seconds", "nan"],
+        ["check", "newton", "--random", "1000000000"],
+        [
+            "fit",
+            "newton",
+            "three_ball_chain",
+            "--data",
+            "x.csv",
+            "--free",
+            "e",
+            "--bootstrap",
+            "1000000000",
+        ],
+        ["fit", "newton", "three_ball_chain", "--data", "x.csv", "--free", "e", "--holdout", "1.5"],
+    ],
+    ids=lambda argv: " ".join(argv[:1] + argv[-2:]),
+)
+def test_every_count_and_wall_clock_limit_has_a_range(tmp_path, capsys, monkeypatch, argv):
+    """A worker count, a repeat count, a seed and a wall-clock limit outside their ranges stop
+    the command at once with a usage error (exit 2) naming the argument: no run starts 100000
+    workers or a billion bootstrap refits, and no limit of -1, 0, NaN or inf seconds is taken."""
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"argument {argv[-2]}" in err[0], err

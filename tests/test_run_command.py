@@ -127,6 +127,7 @@ def test_an_installation_without_extras_solves_and_names_what_is_missing(
 ):
     """Without Dask, h5py and cvxpy the solver and the study engine (what the report runs)
     work; asking for what an extra gives exits 2 naming the extra to install."""
+    (tmp_path / "p.h5").write_bytes(b"\x89HDF\r\n\x1a\n")
     result = subprocess.run(
         [sys.executable, "-c", WITHOUT_EXTRAS, *args],
         cwd=tmp_path,

@@ -44,6 +44,7 @@ from lawbench.core.mechanics import fc3d_error
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.files.hdf5 import require_h5py
+from lawbench.files.paths import input_file, output_file
 
 FORMS = ("local", "global")
 # FCLIB's forms that are not frictional impacts, by their HDF5 group: recognised, and refused.
@@ -161,7 +162,7 @@ def _local_order(problem: ImpactProblem) -> np.ndarray:
 @contextmanager
 def _opened(path: str | Path) -> Iterator[tuple[Any, str, str, int]]:
     """The open file's problem group, its form, its name for messages and its ``spacedim``."""
-    where = str(path)
+    where = str(input_file(path, "FCLIB file"))
     try:
         handle = require_h5py().File(path, "r")
     except OSError as exc:
@@ -295,7 +296,7 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
     """
     if form not in FORMS:
         raise InvalidProblem(f"FCLIB form {form!r}: must be one of {', '.join(FORMS)}")
-    path = Path(path)
+    path = output_file(path, "FCLIB file")
     restituted = [j for j, c in enumerate(problem.contacts) if _restitutes(c)]
     if restituted:
         shown = ", ".join(map(str, restituted[:10])) + (", ..." if len(restituted) > 10 else "")

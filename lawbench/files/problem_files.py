@@ -42,6 +42,7 @@ from lawbench.core.errors import InvalidProblem
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import Contact, ImpactProblem, is_sparse
 from lawbench.files.hdf5 import require_h5py
+from lawbench.files.paths import input_file, output_file
 
 FORMAT, VERSION = "lawbench-problem", 1
 MATRICES = ("M", "Wn", "Wt", "v", "gaps")
@@ -116,7 +117,7 @@ def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
     InvalidProblem
         For an unknown extension, or a file that cannot be written.
     """
-    path = Path(path)
+    path = output_file(path, "problem file")
     writer = _codec(path)[0]
     try:
         writer(to_dict(problem), path)
@@ -136,7 +137,7 @@ def load_problem(path: str | Path) -> ImpactProblem:
         For an unknown extension, an unreadable or malformed file, or a bad field; the
         message names the file and the field.
     """
-    path = Path(path)
+    path = input_file(path, "problem file")
     reader = _codec(path)[1]
     if reader is _read_hdf5:
         from lawbench.files.fclib import is_fclib, read_fclib

@@ -48,6 +48,7 @@ from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
+from lawbench.files.paths import input_file
 
 # Relative singular value of the Jacobian below which a direction counts as flat.
 FLAT_TOL = 1e-4
@@ -85,7 +86,9 @@ def read_trials(
         frame = data.astype(str)
     else:
         try:
-            frame = pd.read_csv(data, dtype=str, keep_default_na=False, skipinitialspace=True)
+            frame = pd.read_csv(
+                input_file(data, "data"), dtype=str, keep_default_na=False, skipinitialspace=True
+            )
         except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
             raise InvalidProblem(f"data {str(data)!r}: cannot be read ({exc})") from None
     frame.columns = [str(c).strip() for c in frame.columns]

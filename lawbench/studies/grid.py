@@ -50,6 +50,7 @@ from lawbench.checks.study import Job, Plan
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
+from lawbench.files.paths import input_file
 from lawbench.numerics.transforms import parse
 
 if TYPE_CHECKING:
@@ -70,7 +71,7 @@ class RunSpec:
     def from_toml(cls, path: Path) -> RunSpec:
         """Read a specification file; a malformed one raises `InvalidProblem`."""
         try:
-            data = tomllib.loads(Path(path).read_text())
+            data = tomllib.loads(input_file(path, "spec").read_text())
         except OSError as exc:
             raise InvalidProblem(f"spec {path}: cannot be read ({exc.strerror})") from None
         except tomllib.TOMLDecodeError as exc:

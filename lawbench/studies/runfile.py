@@ -47,6 +47,7 @@ from filelock import FileLock, Timeout
 
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.verdicts import Verdict
+from lawbench.files.paths import output_file
 
 log = logging.getLogger("lawbench.studies.runner")
 
@@ -208,7 +209,7 @@ def save_run(records: pd.DataFrame, path: Path, meta: Mapping[str, Any]) -> Path
     InvalidProblem
         For an unknown extension, or a file that cannot be written.
     """
-    path = Path(path)
+    path = output_file(path, "run table")
     file_format(path)
     tidied, layout = tidy(records)
     try:

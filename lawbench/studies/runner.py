@@ -34,6 +34,7 @@ from tqdm import tqdm
 from lawbench.checks import run_checks
 from lawbench.checks.study import Job, Measure, Plan
 from lawbench.core.errors import InvalidProblem
+from lawbench.files.paths import output_file
 from lawbench.studies.guard import (
     BUDGET_S,
     EXECUTORS,
@@ -299,7 +300,7 @@ def run_many(
         Before any cell is computed: for an output with an unknown extension, one locked by
         another run (without ``wait``), or one that holds results without ``resume``.
     """
-    stores = [Store(out) for _, out in plans]
+    stores = [Store(output_file(out, "run output")) for _, out in plans]
     meta = metadata(seed)
     with ExitStack() as locks:
         for store in stores:

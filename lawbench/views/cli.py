@@ -14,7 +14,7 @@ import logging
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from lawbench.checks import run_checks
@@ -31,6 +31,7 @@ from lawbench.core.errors import (
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import evaluate
+from lawbench.files.paths import output_file
 from lawbench.numerics.transforms import apply
 from lawbench.studies.guard import BUDGET_S, EXECUTORS, alarm
 from lawbench.views.serialize import trial_record
@@ -64,6 +65,52 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:
         self.exit(2, f"lawbench: {message} (see lawbench --help)\n")
+
+
+# The bounds of the command line's numbers: a count beyond them is a typo or an attack, and a
+# wall-clock limit must be a finite number of seconds.
+MAX_WORKERS = 256
+MAX_REPEATS = 100_000
+MAX_SECONDS = 1e6
+
+
+def _count(low: int, high: int) -> Callable[[str], int]:
+    """An argparse type: an integer within [low, high]."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{value} is outside {low}..{high}")
+        return value
+
+    return parse
+
+
+def _seconds(text: str) -> float:
+    """An argparse type: a wall-clock limit, finite and positive, at most `MAX_SECONDS`."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not 0 < value <= MAX_SECONDS:
+        raise argparse.ArgumentTypeError(
+            f"{text} s: a wall-clock limit is a number of seconds in (0, {MAX_SECONDS:g}]"
+        )
+    return value
+
+
+def _fraction(text: str) -> float:
+    """An argparse type: a fraction in [0, 1)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not 0 <= value < 1:
+        raise argparse.ArgumentTypeError(f"{text} is outside [0, 1)")
+    return value
 
 
 class _Version(argparse.Action):
@@ -275,7 +322,8 @@ def _study(args: argparse.Namespace) -> None:
         raise InvalidProblem("study: give a study's name, or --list")
     given = _assignments(args.set, "--set")
     if args.out:
-        file_format(Path(args.out))  # a bad extension stops before any cell is computed
+        # A bad extension or a path that is not a file stops before any cell is computed.
+        file_format(output_file(args.out, "table"))
     table = study_table(args.name, given, args.executor, args.workers, args.max_seconds)
     print(table.text())
     if args.out:
@@ -295,7 +343,7 @@ def _run(args: argparse.Namespace) -> None:
     spec = spec or inline
     if spec is None:
         raise InvalidProblem("run: give a spec file or --laws/--cases/--param")
-    out = Path(args.out or f"results.{args.format or 'parquet'}")
+    out = output_file(args.out or f"results.{args.format or 'parquet'}", "run output")
     file_format(out, args.format)
     # Counted from the grid's sizes: a grid too large to run is refused before it is built.
     count = spec.count()
@@ -437,10 +485,14 @@ def _number(name: str, text: str) -> float:
 def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
     """The options of the commands that run many cells: executor, workers, guard."""
     parser.add_argument("--executor", choices=EXECUTORS, default=default)
-    parser.add_argument("--workers", type=int, help="worker processes (default: one per core)")
+    parser.add_argument(
+        "--workers",
+        type=_count(1, MAX_WORKERS),
+        help=f"worker processes, at most {MAX_WORKERS} (default: one per core)",
+    )
     parser.add_argument(
         "--max-seconds",
-        type=float,
+        type=_seconds,
         default=BUDGET_S,
         help=f"wall-clock guard of one cell, in seconds (default {BUDGET_S:g})",
     )
@@ -478,7 +530,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     solve.add_argument(
         "--max-seconds",
-        type=float,
+        type=_seconds,
         metavar="S",
         help="stop the solve after S seconds of wall time (exit code 4)",
     )
@@ -566,7 +618,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="a law option for every law of --laws (LAW.NAME for one law), with the grid "
         "spelling of --param (tol=1e-6,1e-10 is two rows)",
     )
-    run.add_argument("--seed", type=int, default=0, help="seed of random samples")
+    run.add_argument("--seed", type=_count(0, 2**32 - 1), default=0, help="seed of random samples")
     run.add_argument(
         "--out", help="output file: .parquet, .csv or .feather (default results.parquet)"
     )
@@ -585,7 +637,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--yes", action="store_true", help=f"run a grid of more than {LARGE_GRID} cells"
     )
     run.add_argument("--quiet", action="store_true", help="no progress bar")
-    run.add_argument("--chunk-size", type=int, default=50, help="rows written per chunk file")
+    run.add_argument(
+        "--chunk-size",
+        type=_count(1, MAX_REPEATS),
+        default=50,
+        help="rows written per chunk file",
+    )
     run.set_defaults(run=_run)
     regress = commands.add_parser("regress", help="compare every law with its baseline")
     regress.add_argument("--update", action="store_true", help="rewrite the baselines")
@@ -597,7 +654,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     check.add_argument("law", help="a law name, or module:attribute of a law not registered")
     check.add_argument("--cases", help="comma-separated scenes (default: every one it treats)")
-    check.add_argument("--random", type=int, default=3, help="seeded random problems (3)")
+    check.add_argument(
+        "--random",
+        type=_count(0, MAX_REPEATS),
+        default=3,
+        help=f"seeded random problems (3; at most {MAX_REPEATS})",
+    )
     check.add_argument("--json", action="store_true", help="print the table as JSON records")
     check.set_defaults(run=_check)
     fitp = commands.add_parser(
@@ -631,10 +693,21 @@ def build_parser() -> argparse.ArgumentParser:
         "--noise", type=float, help="standard deviation of a measured velocity (judges the fit)"
     )
     fitp.add_argument(
-        "--holdout", type=float, default=0.0, metavar="FRACTION", help="trials held back"
+        "--holdout", type=_fraction, default=0.0, metavar="FRACTION", help="trials held back"
     )
-    fitp.add_argument("--bootstrap", type=int, default=0, metavar="N", help="bootstrap refits")
-    fitp.add_argument("--seed", type=int, default=0, help="seed of the holdout and bootstrap")
+    fitp.add_argument(
+        "--bootstrap",
+        type=_count(0, MAX_REPEATS),
+        default=0,
+        metavar="N",
+        help=f"bootstrap refits (at most {MAX_REPEATS})",
+    )
+    fitp.add_argument(
+        "--seed",
+        type=_count(0, 2**32 - 1),
+        default=0,
+        help="seed of the holdout and bootstrap",
+    )
     fitp.add_argument("--json", action="store_true", help="print the results as JSON")
     fitp.set_defaults(run=_fit)
     bench = commands.add_parser(
