@@ -551,3 +551,43 @@ def test_every_count_and_wall_clock_limit_has_a_range(tmp_path, capsys, monkeypa
     assert cli.main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"argument {argv[-2]}" in err[0], err
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["regress", "--laws", "nolaw"], "unknown law 'nolaw'"),
+        (["regress", "--cases", "nocase"], "unknown case 'nocase'"),
+        (["regress", "--laws", ""], "--laws '': an empty name"),
+        (["check", "newton", "--cases", "nocase", "--random", "0"], "unknown case 'nocase'"),
+        (["run", "--laws", "newton", "--cases", ""], "--cases '': an empty name"),
+        (["run", "--laws", "newton,", "--cases", "three_ball_chain"], "an empty name"),
+        (["run", "--laws", "nolaw", "--cases", "three_ball_chain"], "unknown law 'nolaw'"),
+        (["run", "--laws", "newton", "--out", ""], "argument --out: an empty path"),
+        (["study", "rocking_block", "--out", " "], "argument --out: an empty path"),
+        (["report", "--out", ""], "argument --out: an empty path"),
+        (["solve", "newton", "--problem", ""], "argument --problem: an empty path"),
+        (["export", "three_ball_chain", "-o", ""], "an empty path"),
+    ],
+    ids=lambda x: " ".join(x) if isinstance(x, list) else None,
+)
+def test_unknown_or_empty_names_and_paths_are_refused(tmp_path, capsys, monkeypatch, argv, said):
+    """A misspelled or empty law or scene never selects nothing (a regression that 'holds' on
+    no law, a check that passes on no scene), and an empty path never names the current
+    folder: exit 2, one line naming the argument."""
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and said in err[0], err
+    assert not any(tmp_path.iterdir())
+
+
+def test_the_python_api_refuses_unknown_names_too():
+    """regress and check_law name what they do not know rather than return an empty result."""
+    from lawbench.studies.baselines import regress
+    from lawbench.studies.conformance import check_law
+
+    with pytest.raises(lawbench.UnknownName, match="nolaw"):
+        regress(["nolaw"])
+    with pytest.raises(lawbench.UnknownName, match="nocase"):
+        check_law("newton", cases=["nocase"], random_problems=0)

@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.law import LAWS
 from lawbench.studies.grid import RunSpec
 from lawbench.studies.runner import Task, compute
 
@@ -127,6 +129,10 @@ def regress(
 
     With ``update`` the baselines are rewritten and the returned table lists what changed.
     """
+    for name in laws or ():
+        LAWS.get(name)  # an unknown name is an error, never an empty selection that holds
+    for name in cases or ():
+        CASES.get(name)
     spec, tolerances = load(folder)
     obtained = compute_table(spec, laws, cases)
     drift = []

@@ -211,5 +211,7 @@ def check_law(
         declaration is unsound.
     """
     law = LAWS.get(law)
+    for name in cases or ():
+        CASES.get(name)  # an unknown scene is an error, never an empty table that passes
     rows = [run_cell(law, cell, continuity_sizes) for cell in cells(law, cases, random_problems)]
     return CheckReport(law.name, rows, declaration_problems(law))

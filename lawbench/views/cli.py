@@ -30,6 +30,7 @@ from lawbench.core.errors import (
 )
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
+from lawbench.core.registry import Registry
 from lawbench.core.trial import evaluate
 from lawbench.files.paths import output_file
 from lawbench.numerics.transforms import apply
@@ -113,6 +114,13 @@ def _fraction(text: str) -> float:
     return value
 
 
+def _path(text: str) -> str:
+    """An argparse type: a path, never empty (an empty one names the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path")
+    return text
+
+
 class _Version(argparse.Action):
     """``--version``: the installed version, looked up only when asked for."""
 
@@ -170,7 +178,7 @@ def _law_object(text: str) -> Law:
 def _check(args: argparse.Namespace) -> None:
     from lawbench.studies.conformance import check_law
 
-    cases = args.cases.split(",") if args.cases else None
+    cases = _names(args.cases, "--cases", CASES)
     report = check_law(_law_object(args.law), cases=cases, random_problems=args.random)
     frame = report.to_frame()
     if args.json:
@@ -186,6 +194,27 @@ def _check(args: argparse.Namespace) -> None:
         raise CheckFailed(
             f"{report.law} fails the common checks: {', '.join(names) or 'declaration'}"
         )
+
+
+def _names(text: str | None, option: str, registry: Registry) -> list[str] | None:
+    """The names of a comma-separated option, each known to ``registry``; None when not given.
+
+    ``*`` stands for every registered name.
+
+    Raises
+    ------
+    InvalidProblem
+        For an empty name (``--cases ''``), or `UnknownName` for one the registry does not know.
+    """
+    if text is None:
+        return None
+    names = [name.strip() for name in text.split(",")]
+    if not all(names):
+        raise InvalidProblem(f"{option} {text!r}: an empty name (give names, or leave it out)")
+    for name in names:
+        if name != "*":
+            registry.get(name)
+    return names
 
 
 def _short(value: object) -> str:
@@ -390,12 +419,12 @@ def _duration(seconds: float) -> str:
 def _inline_spec(args: argparse.Namespace) -> object:
     from lawbench.studies.grid import RunSpec, parse_values
 
-    if not (args.laws or args.cases or args.param or args.option):
+    if args.laws is None and args.cases is None and not (args.param or args.option):
         return None
     params = {
         name: parse_values(name, text) for name, text in _assignments(args.param, "--param").items()
     }
-    laws = args.laws.split(",") if args.laws else ["*"]
+    laws = _names(args.laws, "--laws", LAWS) or ["*"]
     options: dict[str, dict[str, list]] = {}
     for name, text in _assignments(args.option, "--option").items():
         law, dot, option = name.rpartition(".")
@@ -406,7 +435,7 @@ def _inline_spec(args: argparse.Namespace) -> object:
             options.setdefault(target, {})[option] = parse_values(name, text)
     grid = {
         "laws": laws,
-        "cases": args.cases.split(",") if args.cases else ["*"],
+        "cases": _names(args.cases, "--cases", CASES) or ["*"],
         "params": params,
         "options": options,
     }
@@ -422,8 +451,8 @@ def _bench(args: argparse.Namespace) -> None:
 def _regress(args: argparse.Namespace) -> None:
     from lawbench.studies.baselines import NEW_ROW, regress
 
-    laws = args.laws.split(",") if args.laws else None
-    cases = args.cases.split(",") if args.cases else None
+    laws = _names(args.laws, "--laws", LAWS)
+    cases = _names(args.cases, "--cases", CASES)
     drift = regress(laws, cases, update=args.update)
     if args.update:
         print(f"baselines rewritten; {len(drift)} quantities changed")
@@ -511,7 +540,10 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("law")
     solve.add_argument("case", nargs="?", help="a scene name (or give --problem FILE)")
     solve.add_argument(
-        "--problem", metavar="FILE", help="a problem file (.json, .npz, .h5): see lawbench export"
+        "--problem",
+        type=_path,
+        metavar="FILE",
+        help="a problem file (.json, .npz, .h5): see lawbench export",
     )
     solve.add_argument(
         "--set",
@@ -542,7 +574,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--set", action="append", default=[], metavar="NAME=VALUE", help="a case parameter"
     )
     export.add_argument(
-        "-o", "--out", required=True, metavar="FILE", help="the file: .json, .npz, .h5 or .hdf5"
+        "-o",
+        "--out",
+        type=_path,
+        required=True,
+        metavar="FILE",
+        help="the file: .json, .npz, .h5 or .hdf5",
     )
     export.add_argument(
         "--fclib",
@@ -551,7 +588,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     export.set_defaults(run=_export)
     report = commands.add_parser("report", help="write the comparison report")
-    report.add_argument("--out", default="reports/latest", help="output folder")
+    report.add_argument("--out", type=_path, default="reports/latest", help="output folder")
     size = report.add_mutually_exclusive_group()
     size.add_argument(
         "--quick",
@@ -583,6 +620,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     study.add_argument(
         "--out",
+        type=_path,
         metavar="FILE",
         help="write the whole table to FILE as lawbench run does (.parquet, .csv or .feather)",
     )
@@ -597,7 +635,7 @@ def build_parser() -> argparse.ArgumentParser:
         "Grid points: --param e=0,0.5,1 is three rows; a per-contact vector: "
         '--param "e=[0.9,0.8]" is one row.',
     )
-    run.add_argument("spec", nargs="?", help="a TOML run specification")
+    run.add_argument("spec", nargs="?", type=_path, help="a TOML run specification")
     run.add_argument("--laws", help="comma-separated laws (default: every law that applies)")
     run.add_argument("--cases", help="comma-separated cases (default: every case)")
     run.add_argument(
@@ -620,7 +658,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument("--seed", type=_count(0, 2**32 - 1), default=0, help="seed of random samples")
     run.add_argument(
-        "--out", help="output file: .parquet, .csv or .feather (default results.parquet)"
+        "--out",
+        type=_path,
+        help="output file: .parquet, .csv or .feather (default results.parquet)",
     )
     run.add_argument(
         "--format",
@@ -669,6 +709,7 @@ def build_parser() -> argparse.ArgumentParser:
     fitp.add_argument("case", help="the scene of the experiment")
     fitp.add_argument(
         "--data",
+        type=_path,
         required=True,
         metavar="CSV",
         help="one row per trial; columns COORD_minus and COORD_plus per coordinate (v1_minus,...)",
