@@ -591,3 +591,26 @@ def test_the_python_api_refuses_unknown_names_too():
         regress(["nolaw"])
     with pytest.raises(lawbench.UnknownName, match="nocase"):
         check_law("newton", cases=["nocase"], random_problems=0)
+
+
+def test_library_warnings_stay_in_the_diagnostics_unless_asked_for(capsys, monkeypatch):
+    """A warning raised inside a solve (scipy's LSODA complaining, a numpy overflow) is kept in
+    the outcome's diagnostics, not printed: stderr carries only lawbench's own lines, and the
+    warning is shown under --verbose."""
+    import warnings
+
+    law = type(lawbench.LAWS.get("newton"))
+    resolve = law._resolve
+
+    def noisy(self, problem, options):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        return resolve(self, problem, options)
+
+    monkeypatch.setattr(law, "_resolve", noisy)
+    outcome = lawbench.solve("newton", lawbench.CASES.get("three_ball_chain").build())
+    assert outcome.diagnostics["warnings"] == ["RuntimeWarning: overflow encountered in multiply"]
+    assert cli.main(["solve", "newton", "three_ball_chain", "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert err == "" and "overflow" in json.loads(out)["diagnostics"]["warnings"][0]
+    assert cli.main(["--verbose", "solve", "newton", "three_ball_chain"]) == 0
+    assert "lawbench: warning: RuntimeWarning: overflow" in capsys.readouterr().err

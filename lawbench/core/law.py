@@ -14,6 +14,7 @@ import dataclasses
 import functools
 import math
 import time
+import warnings
 from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -109,7 +110,9 @@ class Law(ABC):
         Returns
         -------
         Outcome
-            With ``diagnostics['wall_time_s']`` and ``diagnostics['options']`` filled in.
+            With ``diagnostics['wall_time_s']`` and ``diagnostics['options']`` filled in, and
+            ``diagnostics['warnings']`` where the solve raised warnings (a library's, or a
+            floating-point overflow): they are kept with the answer, never printed.
 
         Raises
         ------
@@ -134,7 +137,8 @@ class Law(ABC):
         if problem.sparse and not self.takes_sparse:
             problem = problem.dense()
         start = time.perf_counter()
-        with budget.Budget.of(self.name, values):
+        with budget.Budget.of(self.name, values), warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
             if problem.closed_count == problem.m or self.follows_gaps:
                 outcome = self._resolve(problem, values)
             elif problem.closed_count:
@@ -154,6 +158,9 @@ class Law(ABC):
             outcome.diagnostics["separating_contacts"] = list(separating)
             outcome.diagnostics["separating_rule"] = rule
         outcome.diagnostics["wall_time_s"] = wall_time
+        heard = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
+        if heard:
+            outcome.diagnostics["warnings"] = heard
         return outcome
 
     @abstractmethod

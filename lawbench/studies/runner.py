@@ -71,18 +71,21 @@ def compute(task: Task, alarm_s: float | None = None) -> dict[str, Any]:
     ``alarm_s`` guards the cell in this process (`lawbench.studies.guard.alarm`).
     """
     start = time.perf_counter()
+    heard: list[str] = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             with alarm(alarm_s):
                 trial = task.job.solve(task.settings)
+                heard = list(trial.outcome.diagnostics.get("warnings", ()))
                 checks = run_checks(trial, checks=list(task.checks)) if task.checks else {}
                 measures = {name: measure(trial) for name, measure in task.measures.items()}
             record = Record.solved(task.index, task.study, task.job, trial, checks, measures)
         except Exception as exc:  # a cell records its failure and the run goes on
             spent = time.perf_counter() - start
             record = Record.failed(task.index, task.study, task.job, exc, spent)
-    seen = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
+    # The solve's own warnings are kept in its diagnostics; the checks' are caught here.
+    seen = sorted({*heard, *(f"{w.category.__name__}: {w.message}" for w in caught)})
     record.warnings = "; ".join(seen[:WARNINGS_KEPT])
     return record.row()
 

@@ -310,6 +310,9 @@ def _solve(args: argparse.Namespace) -> None:
         from lawbench.files.problem_files import file_diagnostics
 
         record["diagnostics"].update(file_diagnostics(args.problem, trial.outcome))
+    if args.verbose:
+        for heard in record["diagnostics"].get("warnings", ()):
+            print(f"lawbench: warning: {heard}", file=sys.stderr)
     if args.json:
         print(json.dumps(record, indent=2, allow_nan=False))
         return
@@ -531,6 +534,12 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lawbench`` command."""
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
     parser.add_argument("--version", action=_Version, help="print the version and exit")
+    parser.add_argument(
+        "--verbose",
+        action="store_true",
+        help="print the warnings of the numerical libraries (a solve keeps its own in its "
+        "diagnostics)",
+    )
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     commands.add_parser("list", help="list the laws and cases").set_defaults(run=_list)
     describe = commands.add_parser("describe", help="describe a law or a case")
@@ -768,7 +777,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exit_:  # usage errors and --help
         return int(exit_.code or 0)
     try:
-        args.run(args)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            args.run(args)
+        if args.verbose:
+            for warning in caught:
+                print(f"lawbench: warning: {warning.message}", file=sys.stderr)
     except LawbenchError as exc:
         print(f"lawbench: {exc}", file=sys.stderr)
         return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
