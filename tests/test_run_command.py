@@ -68,6 +68,30 @@ def test_an_interrupted_run_resumes_to_the_same_table(tmp_path, stop):
     pd.testing.assert_frame_equal(obtained, expected)
 
 
+def test_ctrl_c_on_a_pool_of_workers_prints_one_line(tmp_path):
+    """A terminal's Ctrl-C reaches the whole process group, workers included: the parent
+    alone answers it (one line, exit 130); no worker prints its traceback."""
+    import os
+
+    grid = ["--laws", "lzb,compliant", "--cases", "ball_chain", "--param", "n=20,30"]
+    process = subprocess.Popen(
+        [sys.executable, "-m", "lawbench", "run", *grid, "--param", "e=0", "--quiet"],
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        process_group=0,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    time.sleep(6)  # the workers have started and are solving plastic chains (seconds each)
+    os.killpg(process.pid, signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    assert stderr.strip().splitlines() == [
+        "lawbench: interrupted; finished rows are kept (rerun with --resume)"
+    ]
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [

@@ -100,8 +100,27 @@ def _end_with_parent() -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
+@contextmanager
+def _deaf_to_ctrl_c() -> Iterator[None]:
+    """Ignore SIGINT meanwhile, in the main thread: a process started now inherits it.
+
+    A Ctrl-C reaches every process of the terminal's group; the parent alone answers it (it
+    stops the run, ends its workers and prints one line), so a worker must not take it, even
+    while it still imports (each would print a traceback).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _serve(connection: Connection) -> None:
     """The loop of a worker: receive a task, run it, send its result back."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _end_with_parent()
     while True:
         try:
@@ -206,7 +225,8 @@ class Guard:
     def _start(self) -> _Worker:
         parent, child = self._context.Pipe()
         process = self._context.Process(target=_serve, args=(child,), daemon=True)
-        process.start()
+        with _deaf_to_ctrl_c():
+            process.start()
         child.close()
         return _Worker(process, parent)
 
