@@ -117,3 +117,36 @@ def test_bad_files_exit_2_with_one_line_naming_the_field(tmp_path, name, content
     done = run("solve", "newton", "--problem", name, cwd=tmp_path)
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize(
+    ("name", "fclib"),
+    [("bc.npz", None), ("bc.json", None), ("bc.h5", None), ("l.h5", "local"), ("g.h5", "global")],
+)
+def test_the_projects_own_large_sparse_exports_are_read_back_and_solved(
+    tmp_path, capsys, name, fclib
+):
+    """A 300-ball chain (its M and W stored sparse) exported in every format is solved from
+    the file with exit 0, every check answered: the momentum check finds the free directions
+    of a sparse problem, and the FCLIB forms interleave sparse columns."""
+    from lawbench.views import cli
+
+    export = ["export", "ball_chain", "--set", "n=300", "-o", str(tmp_path / name)]
+    assert cli.main(export + (["--fclib", fclib] if fclib else [])) == 0
+    capsys.readouterr()
+    assert cli.main(["solve", "moreau", "--problem", str(tmp_path / name), "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["status"] == "ok"
+    assert record["checks"]["momentum"]["verdict"] in ("holds", "refused")
+    if fclib:
+        assert record["diagnostics"]["fc3d_error"] <= 1e-10
+
+
+def test_an_fclib_file_is_written_with_an_hdf5_extension_only(tmp_path):
+    """FCLIB is HDF5: writing it under .json would leave HDF5 bytes where JSON is expected."""
+    from lawbench.files.fclib import write_fclib
+
+    problem = lawbench.CASES.get("three_ball_chain").build(e=[0.0])
+    with pytest.raises(lawbench.InvalidProblem, match=r"extension is \.h5 or \.hdf5"):
+        write_fclib(problem, tmp_path / "x.json")
+    assert not (tmp_path / "x.json").exists()

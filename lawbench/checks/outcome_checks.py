@@ -6,7 +6,7 @@ import numpy as np
 
 from lawbench.checks.base import TOLERANCE, check
 from lawbench.core.mechanics import gap_rates
-from lawbench.core.problem import RESTITUTION_FIELDS
+from lawbench.core.problem import RESTITUTION_FIELDS, is_sparse
 from lawbench.core.trial import Trial
 
 # Rounding allowed on a gap rate, relative to the sum of the velocities it is the difference of.
@@ -97,20 +97,36 @@ def friction_cone(trial: Trial) -> tuple:
     return value, False, f"contact {j}: |Pt| = {tangential[j]:.6g} exceeds mu Pn = {bound:.6g}"
 
 
+# Coordinates up to which the momentum check finds a problem's free directions by a dense SVD
+# (a 2000 x 2000 SVD takes a few seconds).
+FREE_DIRECTIONS_N = 2000
+
+
 @check("momentum", promised=True)
 def momentum(trial: Trial) -> tuple:
     """Largest change of a conserved momentum over the largest momentum.
 
     The conserved momenta are the scene's (``Case.momentum_axes``), or for a problem given as it
-    is, every ``a @ M @ v`` with ``W.T @ a = 0``: the directions no contact impulse can push.
+    is, every ``a @ M @ v`` with ``W.T @ a = 0``: the directions no contact impulse can push,
+    from a dense SVD of ``W`` up to `FREE_DIRECTIONS_N` coordinates.
     """
     M, v = trial.problem.M, trial.problem.v
     if trial.case is not None:
         axes = trial.case.momentum_axes(trial.params)
+    elif trial.problem.n > FREE_DIRECTIONS_N:
+        return (
+            None,
+            None,
+            (
+                f"a problem of {trial.problem.n} coordinates given without its scene: its free "
+                f"directions are computed up to {FREE_DIRECTIONS_N}"
+            ),
+        )
     else:
         import scipy.linalg  # on first use: a scene's solve and check import no scipy.linalg
 
-        free = scipy.linalg.null_space(trial.problem.W.T)
+        W = trial.problem.W
+        free = scipy.linalg.null_space((W.toarray() if is_sparse(W) else W).T)
         axes = free.T if free.size else None
     if axes is None:
         return None, None, "no momentum is conserved (a wall or a fixed point)"

@@ -47,6 +47,8 @@ from lawbench.files.hdf5 import require_h5py
 from lawbench.files.paths import input_file, output_file
 
 FORMS = ("local", "global")
+# FCLIB files are HDF5: an extension that names another encoding would mislead every reader.
+SUFFIXES = (".h5", ".hdf5")
 # FCLIB's forms that are not frictional impacts, by their HDF5 group: recognised, and refused.
 OTHER_FORMS = {"fclib_global_rolling": "the global problem with rolling friction"}
 
@@ -292,11 +294,16 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
     Raises
     ------
     InvalidProblem
-        For an unknown form or a file that cannot be written.
+        For an unknown form, a path whose extension is not an HDF5 one, or a file that cannot
+        be written.
     """
     if form not in FORMS:
         raise InvalidProblem(f"FCLIB form {form!r}: must be one of {', '.join(FORMS)}")
     path = output_file(path, "FCLIB file")
+    if path.suffix.lower() not in SUFFIXES:
+        raise InvalidProblem(
+            f"FCLIB file {path}: FCLIB is HDF5, so its extension is {' or '.join(SUFFIXES)}"
+        )
     restituted = [j for j, c in enumerate(problem.contacts) if _restitutes(c)]
     if restituted:
         shown = ", ".join(map(str, restituted[:10])) + (", ..." if len(restituted) > 10 else "")
@@ -307,8 +314,12 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
             stacklevel=2,
         )
     if problem.Wt is None:
-        W = np.zeros((problem.n, 2 * problem.m))
-        W[:, 0::2] = problem.Wn
+        # Each contact's normal column, then a zero tangent column.
+        blank = scipy.sparse.csc_array((problem.n, problem.m))
+        interleaved = np.ravel(
+            np.column_stack([np.arange(problem.m), problem.m + np.arange(problem.m)])
+        )
+        W = scipy.sparse.hstack([scipy.sparse.csc_array(problem.Wn), blank]).tocsc()[:, interleaved]
         dim = 2
     else:
         W, dim = problem.W[:, _local_order(problem)], problem.d + 1
