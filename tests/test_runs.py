@@ -117,17 +117,59 @@ def test_a_failing_row_is_recorded_and_the_run_goes_on(tmp_path):
     assert "step budget ran out (5 binary impacts" in table["error_message"][0]
 
 
-def test_resume_computes_only_what_is_missing(tmp_path):
+def test_resume_computes_only_what_is_missing(tmp_path, monkeypatch):
+    """A run interrupted after 7 cells keeps them; resuming the same grid computes the rest
+    and gives the table of an uninterrupted run."""
     spec = RunSpec.from_dict(SPEC)
     out = tmp_path / "out.parquet"
     full, _ = run(spec.plan(), tmp_path / "reference.parquet")
-    partial = RunSpec.from_dict({**SPEC, "grid": SPEC["grid"][:1]})
-    run(partial.plan(), out, chunk_size=7)
+    whole = Executor.run
+
+    def interrupted(self, tasks):
+        for done, item in enumerate(whole(self, tasks)):
+            if done == 7:
+                raise KeyboardInterrupt
+            yield item
+
+    monkeypatch.setattr(Executor, "run", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run(spec.plan(), out, chunk_size=3)
+    monkeypatch.setattr(Executor, "run", whole)
     with pytest.raises(lawbench.InvalidProblem, match="--resume"):
         run(spec.plan(), out)
     table, computed = run(spec.plan(), out, resume=True)
-    assert computed == len(spec.rows()) - len(partial.rows())
+    assert computed == len(spec.rows()) - 7
     pd.testing.assert_frame_equal(without_time(table), without_time(full))
+
+
+def test_a_resume_with_another_grid_is_refused_naming_both(tmp_path):
+    """The chunks and the finished table keep their grid's fingerprint: resuming with another
+    grid (which would mix two grids' cells and never finish either) stops before any work."""
+    spec = RunSpec.from_dict(SPEC)
+    partial = RunSpec.from_dict({**SPEC, "grid": SPEC["grid"][:1]})
+    out = tmp_path / "out.parquet"
+    run(partial.plan(), out)
+    cells = len(partial.rows())
+    with pytest.raises(
+        lawbench.InvalidProblem,
+        match=rf"another grid \({cells} cells.*this run's grid is {len(spec.rows())} cells",
+    ):
+        run(spec.plan(), out, resume=True)
+    table, computed = run(partial.plan(), out, resume=True)
+    assert computed == 0 and len(table) == cells
+
+
+def test_a_grid_without_a_cell_writes_nothing_and_says_so(tmp_path):
+    with pytest.raises(lawbench.InvalidProblem, match="the grid has no cell"):
+        run(Plan("empty", []), tmp_path / "out.csv")
+    assert not any(tmp_path.iterdir())
+
+
+def test_an_output_that_cannot_be_written_is_not_called_locked(tmp_path):
+    """A folder that cannot be made is named as such, not as a lock another run holds."""
+    (tmp_path / "file").write_text("")
+    with pytest.raises(lawbench.InvalidProblem, match=r"cannot be written.*Not a directory"):
+        run(RunSpec.from_dict(SPEC).plan(), tmp_path / "file" / "out.csv")
 
 
 # The per-job guard, in every executor.

@@ -50,6 +50,8 @@ from lawbench.core.verdicts import Verdict
 from lawbench.files.paths import output_file
 
 log = logging.getLogger("lawbench.studies.runner")
+# The grid an unfinished output belongs to, beside its chunks.
+GRID_FILE = "grid.json"
 
 FORMATS = {".parquet": "parquet", ".csv": "csv", ".feather": "feather"}
 VECTORS = ("v_plus", "Pn", "Pt")
@@ -332,11 +334,17 @@ class Store:
         self.owner_path = self.out.with_name(self.out.name + ".lock.owner")
         self.damaged: list[str] = []
         self._layout: dict[str, Any] = {}
+        self._grid: dict[str, str] = {}
 
     @contextmanager
     def locked(self, wait: bool = False) -> Iterator[None]:
         """Hold the output's lock; without ``wait``, a held lock raises `InvalidProblem`."""
-        self.out.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.out.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InvalidProblem(f"--out {self.out}: cannot be written ({exc.strerror})") from None
+        if not os.access(self.out.parent, os.W_OK):
+            raise InvalidProblem(f"--out {self.out}: its folder cannot be written")
         lock = FileLock(self.lock_path, timeout=-1 if wait else 0)
         try:
             lock.acquire()
@@ -359,6 +367,32 @@ class Store:
             return self.owner_path.read_text().strip()
         except OSError:
             return "its owner has not written its name yet"
+
+    def claim(self, grid: str, described: str) -> None:
+        """Tie this output to the grid of fingerprint ``grid`` (``described`` in messages).
+
+        Raises
+        ------
+        InvalidProblem
+            When the output's finished table or chunks belong to another grid: resuming there
+            would mix two grids' cells and never finish either.
+        """
+        held = None
+        if (self.parts / GRID_FILE).exists():
+            held = json.loads((self.parts / GRID_FILE).read_text())
+        elif self.out.exists():
+            meta = read_table(self.out)[1]
+            held = (
+                {"grid": meta["grid"], "described": meta["grid_described"]}
+                if "grid" in meta
+                else None
+            )
+        if held is not None and held["grid"] != grid:
+            raise InvalidProblem(
+                f"--out {self.out} holds the cells of another grid ({held['described']}); "
+                f"this run's grid is {described}: give another --out"
+            )
+        self._grid = {"grid": grid, "described": described}
 
     def chunks(self) -> list[Path]:
         """The chunk files, in the order they were written."""
@@ -401,6 +435,8 @@ class Store:
     def write_chunk(self, records: list[dict]) -> None:
         """Write one chunk whole: checksum sidecar first, then the chunk moved in place."""
         self.parts.mkdir(parents=True, exist_ok=True)
+        if self._grid and not (self.parts / GRID_FILE).exists():
+            _atomic_text(self.parts / GRID_FILE, json.dumps(self._grid))
         written = self.chunks()
         number = int(written[-1].stem.split("-")[1]) + 1 if written else 0
         path = self.parts / f"part-{number:06d}.parquet"

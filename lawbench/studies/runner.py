@@ -301,13 +301,19 @@ def run_many(
     ------
     InvalidProblem
         Before any cell is computed: for an output with an unknown extension, one locked by
-        another run (without ``wait``), or one that holds results without ``resume``.
+        another run (without ``wait``), one that holds results without ``resume`` or the cells
+        of another grid (its fingerprint, a digest of the cells' keys, is kept beside the
+        chunks and in the finished table's metadata), or a grid without a cell.
     """
+    empty = [str(out) for plan, out in plans if not plan.jobs]
+    if empty:
+        raise InvalidProblem(f"{', '.join(empty)}: the grid has no cell, so nothing is written")
     stores = [Store(output_file(out, "run output")) for _, out in plans]
-    meta = metadata(seed)
+    grids = [_fingerprint(plan) for plan, _ in plans]
     with ExitStack() as locks:
-        for store in stores:
+        for store, (grid, described) in zip(stores, grids, strict=True):
             locks.enter_context(store.locked(wait))
+            store.claim(grid, described)
         tasks, owner = [], []
         for number, ((plan, out), store) in enumerate(zip(plans, stores, strict=True)):
             finished = store.done()
@@ -338,10 +344,26 @@ def run_many(
                     if buffer:
                         store.write_chunk(buffer)
         computed = [owner.count(number) for number in range(len(plans))]
+        meta = metadata(seed)
         return [
-            (store.finish(len(plan.jobs), meta), count)
-            for store, (plan, _), count in zip(stores, plans, computed, strict=True)
+            (
+                store.finish(len(plan.jobs), {**meta, "grid": grid, "grid_described": described}),
+                count,
+            )
+            for store, (plan, _), count, (grid, described) in zip(
+                stores, plans, computed, grids, strict=True
+            )
         ]
+
+
+def _fingerprint(plan: Plan) -> tuple[str, str]:
+    """A grid's identity (a digest of its cells' keys) and its description in messages."""
+    import hashlib  # on first use: it loads OpenSSL
+
+    digest = hashlib.sha256("\n".join([plan.name, *sorted(job.key for job in plan.jobs)]).encode())
+    grid, cells = digest.hexdigest(), len(plan.jobs)
+    named = f"{plan.name}: " if plan.name else ""
+    return grid, f"{named}{cells} cell{'s' if cells != 1 else ''}, fingerprint {grid[:12]}"
 
 
 def estimate_seconds(sample: Plan, cells: int, workers: int) -> float:

@@ -407,7 +407,8 @@ def _run(args: argparse.Namespace) -> None:
         print(f"{out} is complete: {len(table)} rows, nothing left to compute")
         return
     failed = int((table["error_class"].fillna("") != "").sum()) if len(table) else 0
-    print(f"{len(table)} rows in {out} ({computed} computed now, {failed} failed)")
+    rows = f"{len(table)} row{'s' if len(table) != 1 else ''}"
+    print(f"{rows} in {out} ({computed} computed now, {failed} failed)")
 
 
 def _duration(seconds: float) -> str:
