@@ -275,3 +275,25 @@ def test_exporting_a_restitution_warns_that_fclib_holds_none(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("lawbench: warning: FCLIB holds no restitution")
     assert read_fclib(out).m == 1
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("m", 10**8, "more than the 5e\\+07 entries"),
+        ("m", 7, r"W is 7 x 6 .* need 6 x 6"),
+        ("x", np.array([b"a"] * 6), "not numbers"),
+    ],
+)
+def test_a_matrix_too_large_to_hold_or_not_numeric_is_refused(tmp_path, key, value, message):
+    """A declared shape is bounded before anything is allocated, W is square with one row per
+    contact coordinate, and its entries are numbers."""
+    W, q, mu = random_local(np.random.default_rng(2), 2)
+    path = tmp_path / "p.hdf5"
+    fclib_local(path, W, q, mu, "csc")
+    with h5py.File(path, "a") as handle:
+        group = handle["fclib_local/W"]
+        del group[key]
+        group.create_dataset(key, data=np.atleast_1d(value))
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        read_fclib(path)

@@ -105,13 +105,21 @@ GOOD = {
         ("p.json", {**GOOD, "contacts": [{"e": "half"}]}, r"contacts\[0\]\.e = 'half'"),
         ("p.json", {**GOOD, "contacts": [{"e": 1.5}]}, r"contacts\[0\]\.e = 1\.5"),
         ("p.json", "{not json", "malformed JSON"),
+        ("p.json", {**GOOD, "v": ["a"]}, "field 'v' holds a value that is not a number"),
+        ("p.json", {**GOOD, "M": [["one"]]}, "field 'M' holds a value that is not a number"),
+        ("p.json", json.dumps(GOOD).replace('"v": [', '"v": [NaN, '), r"p\.json: NaN is not"),
+        ("p.json", "[" * 100_000 + "]" * 100_000, "nested deeper"),
+        ("p.json", b'{"format": "lawbench-problem", "x": "\xe9"}', "not UTF-8"),
         ("p.npz", "garbage bytes", "not a lawbench problem file"),
         ("p.txt", GOOD, "unknown extension '.txt'"),
     ],
 )
 def test_bad_files_exit_2_with_one_line_naming_the_field(tmp_path, name, content, message):
     path = tmp_path / name
-    path.write_text(content if isinstance(content, str) else json.dumps(content))
+    if isinstance(content, bytes):
+        path.write_bytes(content)
+    else:
+        path.write_text(content if isinstance(content, str) else json.dumps(content))
     with pytest.raises(lawbench.InvalidProblem, match=message):
         load_problem(path)
     done = run("solve", "newton", "--problem", name, cwd=tmp_path)

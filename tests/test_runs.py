@@ -78,6 +78,21 @@ def test_malformed_toml_is_refused(tmp_path):
         RunSpec.from_toml(path)
 
 
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b'[[grid]]\nlaws = ["n\xe9wton"]\n', "TOML is UTF-8 text"),
+        (b"a = " + b"[" * 100_000 + b"]" * 100_000, "nested deeper"),
+    ],
+    ids=["latin-1", "deep"],
+)
+def test_a_spec_that_is_not_utf8_or_nests_without_end_is_refused(tmp_path, content, message):
+    path = tmp_path / "spec.toml"
+    path.write_bytes(content)
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        RunSpec.from_toml(path)
+
+
 def without_time(table):
     return table.drop(columns=["wall_time_s", "spent_s"]).reset_index(drop=True)
 

@@ -47,6 +47,8 @@ from lawbench.files.hdf5 import require_h5py
 from lawbench.files.paths import input_file, output_file
 
 FORMS = ("local", "global")
+# The largest matrix read (entries, held dense): 400 MB of doubles, far above the field's problems.
+MAX_ENTRIES = 50_000_000
 # FCLIB files are HDF5: an extension that names another encoding would mislead every reader.
 SUFFIXES = (".h5", ".hdf5")
 # FCLIB's forms that are not frictional impacts, by their HDF5 group: recognised, and refused.
@@ -80,10 +82,16 @@ def _read_matrix(group: Any, where: str) -> np.ndarray:
     m, n, nz = number("m"), number("n"), number("nz")
     if m < 0 or n < 0:
         raise InvalidProblem(f"{where}: a matrix of {m} x {n}")
+    if m * n > MAX_ENTRIES:
+        raise InvalidProblem(
+            f"{where}: a matrix of {m} x {n}, more than the {MAX_ENTRIES:.0e} entries read at most"
+        )
     p, i, x = (_array(group, key, where) for key in ("p", "i", "x"))
     for key, index in (("p", p), ("i", i)):
         if not np.issubdtype(index.dtype, np.integer):
             raise InvalidProblem(f"{where}/{key} holds {index.dtype}, not integers")
+    if not (np.issubdtype(x.dtype, np.floating) or np.issubdtype(x.dtype, np.integer)):
+        raise InvalidProblem(f"{where}/x holds {x.dtype}, not numbers")
     if nz >= 0:
         if min(p.size, i.size, x.size) < nz:
             raise InvalidProblem(
@@ -221,13 +229,24 @@ def read_fclib(path: str | Path) -> ImpactProblem:
         else:
             if "V" in root or "R" in root:
                 raise InvalidProblem(f"{where}/V, R: mixed problems are not an impact problem")
-            W = _read_matrix(root["W"], f"{where}/W")
-            q = _vector(vectors, "q", f"{where}/vectors")
+            W, q = _local(root, mu.size * dim, where)
             M, columns, v = _coordinates(W, q, where)
     try:
         return ImpactProblem.from_arrays(M, v=v, **_split(columns, dim, mu, where), e=0.0, mu=mu)
     except InvalidProblem as exc:
         raise InvalidProblem(f"{where}: {exc}") from None
+
+
+def _local(root: Any, size: int, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """The local form's ``W`` and ``q``, checked to be ``size`` x ``size`` and ``size`` long."""
+    W = _read_matrix(root["W"], f"{where}/W")
+    q = _vector(root["vectors"], "q", f"{where}/vectors")
+    if W.shape != (size, size) or q.size != size:
+        raise InvalidProblem(
+            f"{where}: W is {W.shape[0]} x {W.shape[1]} and q holds {q.size} entries; "
+            f"{size} contact coordinates (spacedim times the entries of mu) need {size} x {size}"
+        )
+    return W, q
 
 
 def _solve(M: np.ndarray, f: np.ndarray, where: str) -> np.ndarray:
@@ -264,8 +283,7 @@ def fclib_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
         vectors = root["vectors"]
         mu = _vector(vectors, "mu", f"{where}/vectors")
         if form == "local":
-            W = _read_matrix(root["W"], f"{where}/W")
-            q = _vector(vectors, "q", f"{where}/vectors")
+            W, q = _local(root, mu.size * dim, where)
         else:
             M = _read_matrix(root["M"], f"{where}/M")
             H = _read_matrix(root["H"], f"{where}/H")

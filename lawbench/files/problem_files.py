@@ -92,6 +92,16 @@ def from_dict(data: Mapping[str, Any], where: str = "problem") -> ImpactProblem:
             ):
                 raise InvalidProblem(f"{where}: contacts[{j}].{name} = {value!r}: not a number")
         parsed.append(Contact(**contact))
+    for name in ("M", "Wn", "Wt", "v", "gaps"):
+        value = data.get(name)
+        if value is None or is_sparse(value):
+            continue
+        try:
+            np.asarray(value, dtype=float)
+        except (ValueError, TypeError):
+            raise InvalidProblem(
+                f"{where}: field {name!r} holds a value that is not a number"
+            ) from None
     bodies = data.get("bodies", {})
     if not isinstance(bodies, Mapping):
         raise InvalidProblem(f"{where}: bodies must map names to index lists")
@@ -185,17 +195,20 @@ def _write_json(data: dict[str, Any], path: Path) -> None:
 
 
 def _read_json(path: Path) -> dict[str, Any]:
+    def reject(name: str) -> float:
+        raise InvalidProblem(f"{path}: {name} is not a finite number (a problem holds only those)")
+
     try:
-        data = json.loads(path.read_text(), parse_constant=_reject_constant)
+        data = json.loads(path.read_text(), parse_constant=reject)
     except json.JSONDecodeError as exc:
         raise InvalidProblem(f"{path}: malformed JSON ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise InvalidProblem(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except RecursionError:
+        raise InvalidProblem(f"{path}: JSON nested deeper than a problem ever is") from None
     if not isinstance(data, dict):
         raise InvalidProblem(f"{path}: expected a JSON object")
     return data
-
-
-def _reject_constant(name: str) -> float:
-    raise InvalidProblem(f"{name} is not a finite number")
 
 
 def _arrays(data: dict[str, Any]) -> dict[str, np.ndarray]:

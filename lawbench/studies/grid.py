@@ -71,11 +71,17 @@ class RunSpec:
     def from_toml(cls, path: Path) -> RunSpec:
         """Read a specification file; a malformed one raises `InvalidProblem`."""
         try:
-            data = tomllib.loads(input_file(path, "spec").read_text())
+            data = tomllib.loads(input_file(path, "spec").read_bytes().decode("utf-8"))
         except OSError as exc:
             raise InvalidProblem(f"spec {path}: cannot be read ({exc.strerror})") from None
+        except UnicodeDecodeError as exc:
+            raise InvalidProblem(
+                f"spec {path}: TOML is UTF-8 text ({exc.reason} at byte {exc.start})"
+            ) from None
         except tomllib.TOMLDecodeError as exc:
             raise InvalidProblem(f"spec {path}: malformed TOML ({exc})") from None
+        except RecursionError:
+            raise InvalidProblem(f"spec {path}: nested deeper than a run file ever is") from None
         return cls.from_dict(data)
 
     @classmethod
