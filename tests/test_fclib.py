@@ -111,17 +111,22 @@ def test_local_and_global_round_trips(tmp_path, case):
     )
 
 
+def solved_from_the_command_line(folder, name):
+    """The JSON record of ``lawbench solve moreau --problem NAME`` run in ``folder`` (exit 0)."""
+    done = subprocess.run(
+        [sys.executable, "-m", "lawbench", "solve", "moreau", "--problem", name, "--json"],
+        capture_output=True,
+        text=True,
+        cwd=folder,
+    )
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
 def test_solve_an_fclib_file_from_the_command_line(tmp_path):
     W, q, mu = random_local(np.random.default_rng(5), 2)
     fclib_local(tmp_path / "p.hdf5", W, q, mu, "csc")
-    done = subprocess.run(
-        [sys.executable, "-m", "lawbench", "solve", "moreau", "--problem", "p.hdf5", "--json"],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-    )
-    assert done.returncode == 0, done.stderr
-    assert len(json.loads(done.stdout)["Pn"]) == 2
+    assert len(solved_from_the_command_line(tmp_path, "p.hdf5")["Pn"]) == 2
 
 
 def test_a_file_that_is_not_an_impact_problem_is_refused_by_name(tmp_path):
@@ -205,16 +210,8 @@ def test_the_fc3d_error_is_measured_on_the_files_own_asymmetric_w(tmp_path):
     found = fclib_diagnostics(tmp_path / "asym.hdf5", outcome)
     assert found["W_asymmetry"] == pytest.approx(2e-4 / np.abs(W + skew - skew.T).max())
     assert 1e-7 < found["fc3d_error"] < 1e-2
-    done = subprocess.run(
-        [sys.executable, "-m", "lawbench", "solve", "moreau", "--problem", "asym.hdf5", "--json"],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-    )
-    assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout)["diagnostics"]["fc3d_error"] == pytest.approx(
-        found["fc3d_error"]
-    )
+    record = solved_from_the_command_line(tmp_path, "asym.hdf5")
+    assert record["diagnostics"]["fc3d_error"] == pytest.approx(found["fc3d_error"])
 
 
 @pytest.mark.parametrize(

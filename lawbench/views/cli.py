@@ -90,28 +90,27 @@ def _count(low: int, high: int) -> Callable[[str], int]:
     return parse
 
 
-def _seconds(text: str) -> float:
-    """An argparse type: a wall-clock limit, finite and positive, at most `MAX_SECONDS`."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
-    if not 0 < value <= MAX_SECONDS:
-        raise argparse.ArgumentTypeError(
-            f"{text} s: a wall-clock limit is a number of seconds in (0, {MAX_SECONDS:g}]"
-        )
-    return value
+def _real(accepts: Callable[[float], bool], what: str) -> Callable[[str], float]:
+    """An argparse type: a number that ``accepts`` (``what`` says which, in its message)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not accepts(value):
+            raise argparse.ArgumentTypeError(f"{text}: {what}")
+        return value
+
+    return parse
 
 
-def _fraction(text: str) -> float:
-    """An argparse type: a fraction in [0, 1)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not 0 <= value < 1:
-        raise argparse.ArgumentTypeError(f"{text} is outside [0, 1)")
-    return value
+# A wall-clock limit: finite and positive, at most MAX_SECONDS (NaN fails both comparisons).
+_seconds = _real(
+    lambda value: 0 < value <= MAX_SECONDS,
+    f"a wall-clock limit is a number of seconds in (0, {MAX_SECONDS:g}]",
+)
+_fraction = _real(lambda value: 0 <= value < 1, "a fraction is in [0, 1)")
 
 
 def _path(text: str) -> str:
