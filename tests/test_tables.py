@@ -332,3 +332,14 @@ def test_laws_with_the_same_answers_are_drawn_as_one_line_named_after_them_all()
     labels = [line.get_label() for line in figure.figure.axes[0].get_lines()]
     assert sorted(labels) == ["lzb", "moreau = newton"]
     plt.close(figure.figure)
+
+
+def test_a_study_whose_every_cell_ran_out_of_time_prints_its_notes(capsys):
+    """No cell answered, so no measure column exists: the table says so and the notes say why
+    (it raised a KeyError on the first missing measure)."""
+    from lawbench.views import cli
+
+    argv = ["study", "rocking_block", "--set", "mu=0", "--max-seconds", "0.0001"]
+    assert cli.main(argv) == 0
+    out = capsys.readouterr().out
+    assert "(no cell gave an answer)" in out and "budget on" in out

@@ -40,6 +40,8 @@ class Table:
         if data.empty or "error_class" not in data:
             return pd.DataFrame()
         answered = data[data["error_class"].fillna("") == ""]
+        if answered.empty:  # every cell failed: no measure was written, the notes say why
+            return pd.DataFrame()
         columns: dict[str, Any] = {"law": answered["law"]}
         if len(set(data["case"])) > 1:
             columns["case"] = answered["case"]
