@@ -158,3 +158,26 @@ def test_an_fclib_file_is_written_with_an_hdf5_extension_only(tmp_path):
     with pytest.raises(lawbench.InvalidProblem, match=r"extension is \.h5 or \.hdf5"):
         write_fclib(problem, tmp_path / "x.json")
     assert not (tmp_path / "x.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("key", "entry", "value", "message"),
+    [
+        ("indices", 5, 10**6, "indices must be < 300"),
+        ("indptr", 3, 10**7, "indptr must be a non-decreasing sequence"),
+    ],
+)
+def test_corrupt_sparse_index_arrays_are_refused_before_they_are_read(
+    tmp_path, key, entry, value, message
+):
+    """An index beyond the matrix in an NPZ's sparse triplets would be read out of bounds by
+    scipy's compiled loops (the process died): every index is checked first, naming the file
+    and the field."""
+    path = tmp_path / "ok.npz"
+    save_problem(lawbench.CASES.get("ball_chain").build(n=300), path)
+    arrays = dict(np.load(path, allow_pickle=False))
+    corrupt = arrays[f"M.{key}"].copy()
+    corrupt[entry] = value
+    np.savez(tmp_path / "bad.npz", **{**arrays, f"M.{key}": corrupt})
+    with pytest.raises(lawbench.InvalidProblem, match=rf"bad\.npz: field 'M': .*{message}"):
+        load_problem(tmp_path / "bad.npz")

@@ -245,8 +245,8 @@ def _arrays(data: dict[str, Any]) -> dict[str, np.ndarray]:
     return arrays
 
 
-def _from_arrays(get: Callable[[str], Any], names: set[str]) -> dict[str, Any]:
-    """Plain data from the flat arrays of an NPZ or HDF5 file."""
+def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> dict[str, Any]:
+    """Plain data from the flat arrays of the NPZ or HDF5 file ``where``."""
     data: dict[str, Any] = {}
     for key in ("format", "version"):
         if key in names:
@@ -265,6 +265,14 @@ def _from_arrays(get: Callable[[str], Any], names: set[str]) -> dict[str, Any]:
             matrix = scipy.sparse.csr_matrix(
                 (get(f"{name}.data"), get(f"{name}.indices"), get(f"{name}.indptr")), shape
             )
+            # Every index within the shape before anything reads the entries: an index out of
+            # range would be read out of bounds by scipy's compiled loops.
+            try:
+                matrix.check_format(full_check=True)
+            except ValueError as exc:
+                raise InvalidProblem(
+                    f"{where}: field {name!r}: its sparse index arrays are corrupt ({exc})"
+                ) from None
             data[name] = matrix if sparse else matrix.toarray()
     return data
 
@@ -276,7 +284,7 @@ def _write_npz(data: dict[str, Any], path: Path) -> None:
 
 def _read_npz(path: Path) -> dict[str, Any]:
     with np.load(path, allow_pickle=False) as archive:
-        return _from_arrays(lambda key: archive[key], set(archive.files))
+        return _from_arrays(lambda key: archive[key], set(archive.files), path)
 
 
 def _write_hdf5(data: dict[str, Any], path: Path) -> None:
@@ -292,7 +300,7 @@ def _read_hdf5(path: Path) -> dict[str, Any]:
         if FORMAT not in handle:
             raise InvalidProblem(f"{path}: no group {FORMAT!r} (not a lawbench problem file)")
         group = handle[FORMAT]
-        return _from_arrays(lambda key: group[key][()], set(group))
+        return _from_arrays(lambda key: group[key][()], set(group), path)
 
 
 CODECS: dict[str, tuple[Callable, Callable]] = {
