@@ -141,3 +141,11 @@ def test_a_ten_thousand_ball_chain_solves_sparse():
     outcome = lawbench.LAWS.get("moreau").resolve(problem)
     assert outcome.diagnostics["polished"]
     np.testing.assert_allclose(outcome.v_plus, masses @ velocities / masses.sum(), atol=1e-10)
+
+
+def test_a_dense_law_refuses_a_problem_too_large_to_hold_dense():
+    """The 100000-ball chain is built sparse (its range allows it); a law that works on dense
+    matrices refuses it naming the size, rather than allocating 75 GiB."""
+    problem = lawbench.CASES.get("ball_chain").build(n=100_000)
+    with pytest.raises(lawbench.NotApplicable, match=r"74\.5 GiB dense"):
+        lawbench.solve("newton", problem)

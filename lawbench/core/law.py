@@ -33,6 +33,11 @@ if TYPE_CHECKING:
     from lawbench.core.batch import OutcomeBatch, ProblemBatch
 
 
+# The largest dense copy of a sparse problem made for a law that works on dense matrices: the
+# 100000-ball chain's mass matrix alone would take 75 GiB.
+DENSE_BYTES = 2**31
+
+
 class Law(ABC):
     """Base class of the impact laws.
 
@@ -135,6 +140,13 @@ class Law(ABC):
                 "and the law states no rule for them"
             )
         if problem.sparse and not self.takes_sparse:
+            dense_bytes = 8 * problem.n * max(problem.n, problem.W.shape[1])
+            if dense_bytes > DENSE_BYTES:
+                raise NotApplicable(
+                    f"{self.name}: works on dense matrices, and this problem's {problem.n} "
+                    f"coordinates would take {dense_bytes / 2**30:.3g} GiB dense (at most "
+                    f"{DENSE_BYTES / 2**30:g} GiB): a law that takes sparse problems treats it"
+                )
             problem = problem.dense()
         start = time.perf_counter()
         with budget.Budget.of(self.name, values), warnings.catch_warnings(record=True) as caught:
