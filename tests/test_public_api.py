@@ -96,6 +96,11 @@ def test_run_checks_on_a_problem_of_your_own():
             "case was given with it",
         ),
         (lambda: lawbench.run_checks("newton", "three_ball_chain", checks=[1]), "checks must be"),
+        (lambda: lawbench.load_problem(123), r"problem file: a path \(str or os.PathLike\)"),
+        (
+            lambda: lawbench.save_problem(lawbench.CASES["three_ball_chain"].build(), None),
+            "problem file: a path",
+        ),
     ],
 )
 def test_a_wrong_argument_is_a_type_error_that_names_it(call, named):
@@ -108,3 +113,9 @@ def test_an_unknown_check_is_named_with_the_known_ones():
         lawbench.InvalidProblem, match=r"unknown check 'colour'; known: .*energy_gain"
     ):
         lawbench.run_checks("newton", "three_ball_chain", checks=["colour"])
+
+
+def test_a_problem_with_a_vector_that_is_not_numeric_is_invalid_naming_it():
+    """Not a bare ValueError from numpy: the field is named."""
+    with pytest.raises(lawbench.InvalidProblem, match="v: not an array of numbers"):
+        lawbench.ImpactProblem.from_arrays(np.eye(2), np.array([[-1.0], [1.0]]), v=["a", "b"])

@@ -390,7 +390,10 @@ class ImpactProblem:
     ) -> None:
         # Every field is checked here and the problem keeps its own read-only copies, written
         # once into the instance (the dataclass is frozen).
-        v = np.array(v, dtype=float, ndmin=1)
+        try:
+            v = np.array(v, dtype=float, ndmin=1)
+        except (TypeError, ValueError) as exc:
+            raise InvalidProblem(f"v: not an array of numbers ({exc})") from None
         n = v.shape[0] if v.ndim == 1 else -1
         if n < 1:
             raise InvalidProblem(f"v has shape {v.shape}, expected (n,) with n >= 1")

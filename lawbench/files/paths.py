@@ -9,6 +9,7 @@ status, which never blocks, before anything is opened.
 
 from __future__ import annotations
 
+import os
 import stat
 from pathlib import Path
 
@@ -29,6 +30,12 @@ def _kind(mode: int) -> str:
     return next((name for test, name in KINDS.items() if test(mode)), "not a regular file")
 
 
+def _path(path: object, what: str) -> Path:
+    if not isinstance(path, str | os.PathLike):
+        raise TypeError(f"{what}: a path (str or os.PathLike), not {type(path).__name__}")
+    return Path(path)
+
+
 def input_file(path: str | Path, what: str = "file") -> Path:
     """``path`` as a `Path` once it is known to be a readable regular file of bounded size.
 
@@ -36,8 +43,10 @@ def input_file(path: str | Path, what: str = "file") -> Path:
     ------
     InvalidProblem
         Naming ``what`` and the path: missing, not a regular file, or larger than `MAX_BYTES`.
+    TypeError
+        For a ``path`` that is not a path.
     """
-    path = Path(path)
+    path = _path(path, what)
     try:
         info = path.stat()
     except OSError as exc:
@@ -58,8 +67,10 @@ def output_file(path: str | Path, what: str = "output") -> Path:
     ------
     InvalidProblem
         Naming ``what`` and the path, for an existing path that is not a regular file.
+    TypeError
+        For a ``path`` that is not a path.
     """
-    path = Path(path)
+    path = _path(path, what)
     try:
         mode = path.stat().st_mode
     except FileNotFoundError:
