@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse
 
-from lawbench.core.errors import InvalidProblem, LossyExport, NotApplicable
+from lawbench.core.errors import InvalidProblem, LawbenchError, LossyExport, NotApplicable
 from lawbench.core.mechanics import fc3d_error
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
@@ -61,7 +61,7 @@ def is_fclib(path: str | Path) -> bool:
         with require_h5py().File(path, "r") as handle:
             groups = [f"fclib_{form}" for form in FORMS] + list(OTHER_FORMS)
             return any(group in handle for group in groups)
-    except OSError:
+    except (OSError, RuntimeError, KeyError):  # not HDF5, or a damaged one
         return False
 
 
@@ -178,25 +178,31 @@ def _opened(path: str | Path) -> Iterator[tuple[Any, str, str, int]]:
     except OSError as exc:
         raise InvalidProblem(f"{where}: cannot be read as HDF5 ({exc})") from None
     with handle:
-        if "fclib_global" in handle:
-            root, form = handle["fclib_global"], "global"
-        elif "fclib_local" in handle:
-            root, form = handle["fclib_local"], "local"
-        else:
-            for group, name in OTHER_FORMS.items():
-                if group in handle:
-                    raise NotApplicable(
-                        f"{where}: /{group} is FCLIB's {name}; the impact laws here have "
-                        "Coulomb friction only (no rolling resistance)"
-                    )
-            raise InvalidProblem(f"{where}: neither /fclib_local nor /fclib_global")
-        where = f"{where}:/fclib_{form}"
-        dim = int(np.asarray(root["spacedim"][()]).ravel()[0]) if "spacedim" in root else 3
-        if dim not in (2, 3):
-            raise InvalidProblem(f"{where}/spacedim = {dim}: must be 2 or 3")
-        if "vectors" not in root:
-            raise InvalidProblem(f"{where}/vectors is missing")
-        yield root, form, where, dim
+        try:
+            if "fclib_global" in handle:
+                root, form = handle["fclib_global"], "global"
+            elif "fclib_local" in handle:
+                root, form = handle["fclib_local"], "local"
+            else:
+                for group, name in OTHER_FORMS.items():
+                    if group in handle:
+                        raise NotApplicable(
+                            f"{where}: /{group} is FCLIB's {name}; the impact laws here have "
+                            "Coulomb friction only (no rolling resistance)"
+                        )
+                raise InvalidProblem(f"{where}: neither /fclib_local nor /fclib_global")
+            where = f"{where}:/fclib_{form}"
+            dim = int(np.asarray(root["spacedim"][()]).ravel()[0]) if "spacedim" in root else 3
+            if dim not in (2, 3):
+                raise InvalidProblem(f"{where}/spacedim = {dim}: must be 2 or 3")
+            if "vectors" not in root:
+                raise InvalidProblem(f"{where}/vectors is missing")
+            yield root, form, where, dim
+        except LawbenchError:
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError) as exc:
+            # h5py's errors for a damaged structure, met wherever the file is read.
+            raise InvalidProblem(f"{where}: a damaged HDF5 file ({exc})") from None
 
 
 def read_fclib(path: str | Path) -> ImpactProblem:

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import json
 import zipfile
+import zlib
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -160,7 +161,17 @@ def load_problem(path: str | Path) -> ImpactProblem:
         raise
     except OSError as exc:
         raise InvalidProblem(f"{path}: cannot be read ({exc.strerror or exc})") from None
-    except (ValueError, KeyError, TypeError, zipfile.BadZipFile) as exc:
+    except (
+        ValueError,
+        KeyError,
+        TypeError,
+        EOFError,
+        RuntimeError,
+        zipfile.BadZipFile,
+        zlib.error,
+    ) as exc:
+        # A damaged file: RuntimeError is h5py's word for a broken HDF5 structure, zlib's
+        # error an NPZ member that does not inflate.
         raise InvalidProblem(f"{path}: not a lawbench problem file ({exc})") from None
     return from_dict(data, str(path))
 

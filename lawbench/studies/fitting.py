@@ -89,7 +89,12 @@ def read_trials(
             frame = pd.read_csv(
                 input_file(data, "data"), dtype=str, keep_default_na=False, skipinitialspace=True
             )
-        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        except (
+            OSError,
+            UnicodeDecodeError,
+            pd.errors.ParserError,
+            pd.errors.EmptyDataError,
+        ) as exc:
             raise InvalidProblem(f"data {str(data)!r}: cannot be read ({exc})") from None
     frame.columns = [str(c).strip() for c in frame.columns]
     minus, plus = columns(case, params)

@@ -1,0 +1,119 @@
+"""Fuzzing the files a user hands over: a corrupted file is refused, never a crash.
+
+Hypothesis corrupts valid files of every format lawbench reads (its problem files in JSON, NPZ
+and HDF5; FCLIB's local and global forms, among them a problem written by LMGC90; a TOML run
+file; a CSV of measurements) by flipping, cutting and inserting bytes, and reads each back. A
+read ends in a problem (the corruption missed what matters) or a `LawbenchError` naming what is
+wrong: never another exception, and never the end of the process (an index read out of range).
+The deeper run (more examples) is marked slow.
+"""
+
+import shutil
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import lawbench
+from lawbench.files.fclib import write_fclib
+from lawbench.files.problem_files import load_problem, save_problem
+from lawbench.studies.fitting import read_trials
+from lawbench.studies.grid import RunSpec
+
+pytest.importorskip("h5py")
+
+FIELD = Path(__file__).parent / "data" / "fclib" / "LMGC_GFC3D-i00001-1-00000.hdf5"
+SPEC = b"""[[grid]]
+laws = ["newton"]
+cases = ["three_ball_chain"]
+params = { e = [0.0, 0.5] }
+"""
+TRIALS = b"v1_minus,v2_minus,v3_minus,v1_plus,v2_plus,v3_plus\n1,0,0,0,0,1\n1,0,0,0.1,0,0.9\n"
+
+
+def _problem_file(folder: Path, name: str) -> Path:
+    problem = lawbench.CASES.get("ball_chain").build(n=40)
+    return save_problem(problem, folder / name)
+
+
+def _fclib_file(folder: Path, form: str) -> Path:
+    problem = lawbench.CASES.get("sphere_wall").build(e=0.0, e_t=0.0)
+    return write_fclib(problem, folder / f"{form}.h5", form)
+
+
+def _copy(folder: Path, source: Path) -> Path:
+    return Path(shutil.copy(source, folder / source.name))
+
+
+def _text(folder: Path, name: str, content: bytes) -> Path:
+    path = folder / name
+    path.write_bytes(content)
+    return path
+
+
+# Each format: how to make a valid file in a folder, and how lawbench reads it.
+FORMATS = {
+    "json": (lambda f: _problem_file(f, "p.json"), load_problem),
+    "npz": (lambda f: _problem_file(f, "p.npz"), load_problem),
+    "hdf5": (lambda f: _problem_file(f, "p.h5"), load_problem),
+    "fclib-local": (lambda f: _fclib_file(f, "local"), load_problem),
+    "fclib-global": (lambda f: _fclib_file(f, "global"), load_problem),
+    "fclib-lmgc90": (lambda f: _copy(f, FIELD), load_problem),
+    "toml": (lambda f: _text(f, "spec.toml", SPEC), RunSpec.from_toml),
+    "csv": (lambda f: _text(f, "trials.csv", TRIALS), lambda p: read_trials(p, "three_ball_chain")),
+}
+
+edits = st.lists(
+    st.one_of(
+        st.tuples(st.just("flip"), st.floats(0, 1, exclude_max=True), st.integers(1, 255)),
+        st.tuples(st.just("cut"), st.floats(0, 1), st.just(0)),
+        st.tuples(st.just("insert"), st.floats(0, 1), st.integers(0, 255)),
+    ),
+    min_size=1,
+    max_size=6,
+)
+
+
+def corrupted(data: bytes, changes: list[tuple[str, float, int]]) -> bytes:
+    """``data`` with each change applied at its relative position."""
+    out = bytearray(data)
+    for kind, where, value in changes:
+        at = min(int(where * len(out)), max(len(out) - 1, 0))
+        if kind == "flip" and out:
+            out[at] ^= value
+        elif kind == "cut":
+            del out[at:]
+        else:
+            out.insert(at, value)
+    return bytes(out)
+
+
+def _reads_or_refuses(tmp_path_factory, fmt: str, changes: list) -> None:
+    make, read = FORMATS[fmt]
+    folder = tmp_path_factory.mktemp(fmt)
+    path = make(folder)
+    path.write_bytes(corrupted(path.read_bytes(), changes))
+    try:
+        read(path)
+    except lawbench.LawbenchError:
+        pass
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+@settings(
+    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(changes=edits)
+def test_a_corrupted_file_is_read_or_refused(tmp_path_factory, fmt, changes):
+    _reads_or_refuses(tmp_path_factory, fmt, changes)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fmt", FORMATS)
+@settings(
+    max_examples=400, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(changes=edits)
+def test_a_corrupted_file_is_read_or_refused_deeply(tmp_path_factory, fmt, changes):
+    _reads_or_refuses(tmp_path_factory, fmt, changes)
