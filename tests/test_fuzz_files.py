@@ -12,7 +12,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import lawbench
@@ -89,31 +89,21 @@ def corrupted(data: bytes, changes: list[tuple[str, float, int]]) -> bytes:
     return bytes(out)
 
 
-def _reads_or_refuses(tmp_path_factory, fmt: str, changes: list) -> None:
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("examples", [25, pytest.param(400, marks=pytest.mark.slow)])
+def test_a_corrupted_file_is_read_or_refused(tmp_path_factory, fmt, examples):
     make, read = FORMATS[fmt]
-    folder = tmp_path_factory.mktemp(fmt)
-    path = make(folder)
-    path.write_bytes(corrupted(path.read_bytes(), changes))
-    try:
-        read(path)
-    except lawbench.LawbenchError:
-        pass
+    valid = make(tmp_path_factory.mktemp(fmt)).read_bytes()
 
+    @settings(max_examples=examples, deadline=None)
+    @given(changes=edits)
+    def read_back(changes):
+        folder = tmp_path_factory.mktemp(fmt)
+        path = make(folder)
+        path.write_bytes(corrupted(valid, changes))
+        try:
+            read(path)
+        except lawbench.LawbenchError:
+            pass
 
-@pytest.mark.parametrize("fmt", FORMATS)
-@settings(
-    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
-@given(changes=edits)
-def test_a_corrupted_file_is_read_or_refused(tmp_path_factory, fmt, changes):
-    _reads_or_refuses(tmp_path_factory, fmt, changes)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("fmt", FORMATS)
-@settings(
-    max_examples=400, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
-@given(changes=edits)
-def test_a_corrupted_file_is_read_or_refused_deeply(tmp_path_factory, fmt, changes):
-    _reads_or_refuses(tmp_path_factory, fmt, changes)
+    read_back()
