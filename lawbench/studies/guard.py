@@ -210,6 +210,11 @@ class Guard:
                 waiting.discard(handle)
                 yield handle, self._results.pop(handle)
 
+    def start(self) -> None:
+        """Start every worker now: their start-up (imports) overlaps what the caller does next."""
+        while len(self._pool) < self.workers:
+            self._pool.append(self._start())
+
     def close(self) -> None:
         """Stop every worker."""
         for worker in self._pool:
@@ -248,8 +253,7 @@ class Guard:
         """Hand out queued tasks, then wait for one answer or one deadline."""
         from multiprocessing.connection import wait
 
-        while len(self._pool) < self.workers:
-            self._pool.append(self._start())
+        self.start()
         for worker in self._pool:
             if worker.task is None and self._queue:
                 task = self._queue.popleft()

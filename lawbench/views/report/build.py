@@ -71,23 +71,24 @@ def build(out: Path, config: Config) -> Path:
     start = time.perf_counter()
     ctx = Context(config, out)
     ctx.run([view for module in SECTIONS for view in module.VIEWS])
-    sections = [_section(module, ctx) for module in SECTIONS]
-    seconds = time.perf_counter() - start
-    preamble = [*_preamble(ctx, config, seconds), *headline(ctx)]
-    write_page(out, TITLE, preamble, sections, ctx.rerun, _save(config))
+    with Guard(config.workers, DRAWING_S) as drawing:
+        drawing.start()  # the drawing workers start up while the sections are built
+        sections = [_section(module, ctx) for module in SECTIONS]
+        seconds = time.perf_counter() - start
+        preamble = [*_preamble(ctx, config, seconds), *headline(ctx)]
+        write_page(out, TITLE, preamble, sections, ctx.rerun, _save(drawing))
     return out
 
 
-def _save(config: Config) -> Any:
+def _save(guard: Guard) -> Any:
     def save(figures: list[Figure], out: Path) -> None:
-        """Draw the figures in worker processes, all at once."""
-        with Guard(config.workers, DRAWING_S) as guard:
-            handles = [guard.submit(save_figure, f.figure, f.name, f.data, out) for f in figures]
-            for figure, handle in zip(figures, handles, strict=True):
-                result = guard.result(handle)
-                if result.status != "ok":
-                    reason = f"{result.error_class or result.status}: {result.error_message}"
-                    raise RuntimeError(f"figure {figure.name} could not be written: {reason}")
+        """Draw the figures in the workers of ``guard``, all at once."""
+        handles = [guard.submit(save_figure, f.figure, f.name, f.data, out) for f in figures]
+        for figure, handle in zip(figures, handles, strict=True):
+            result = guard.result(handle)
+            if result.status != "ok":
+                reason = f"{result.error_class or result.status}: {result.error_message}"
+                raise RuntimeError(f"figure {figure.name} could not be written: {reason}")
 
     return save
 
