@@ -377,22 +377,17 @@ class Store:
             When the output's finished table or chunks belong to another grid: resuming there
             would mix two grids' cells and never finish either.
         """
-        held = None
+        held: dict[str, Any] = {}
         if (self.parts / GRID_FILE).exists():
             held = json.loads((self.parts / GRID_FILE).read_text())
         elif self.out.exists():
-            meta = read_table(self.out)[1]
-            held = (
-                {"grid": meta["grid"], "described": meta["grid_described"]}
-                if "grid" in meta
-                else None
-            )
-        if held is not None and held["grid"] != grid:
+            held = read_table(self.out)[1]
+        if held.get("grid", grid) != grid:
             raise InvalidProblem(
-                f"--out {self.out} holds the cells of another grid ({held['described']}); "
+                f"--out {self.out} holds the cells of another grid ({held['grid_described']}); "
                 f"this run's grid is {described}: give another --out"
             )
-        self._grid = {"grid": grid, "described": described}
+        self._grid = {"grid": grid, "grid_described": described}
 
     def chunks(self) -> list[Path]:
         """The chunk files, in the order they were written."""

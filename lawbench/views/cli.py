@@ -284,15 +284,10 @@ def _export(args: argparse.Namespace) -> None:
     from lawbench.files.problem_files import save_problem
 
     problem = CASES.get(args.case).build(**_assignments(args.set, "--set"))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", LossyExport)
-        if args.fclib:
-            path = write_fclib(problem, args.out, args.fclib)
-        else:
-            path = save_problem(problem, args.out)
-    for warning in caught:
-        if issubclass(warning.category, LossyExport):
-            print(f"lawbench: warning: {warning.message}", file=sys.stderr)
+    if args.fclib:
+        path = write_fclib(problem, args.out, args.fclib)
+    else:
+        path = save_problem(problem, args.out)
     print(f"problem written to {path}")
 
 
@@ -780,8 +775,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             args.run(args)
-        if args.verbose:
-            for warning in caught:
+        # What an export leaves out is always said; a library's warnings only when asked for.
+        for warning in caught:
+            if args.verbose or issubclass(warning.category, LossyExport):
                 print(f"lawbench: warning: {warning.message}", file=sys.stderr)
     except LawbenchError as exc:
         print(f"lawbench: {exc}", file=sys.stderr)
