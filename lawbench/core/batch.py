@@ -23,7 +23,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.problem import RESTITUTION_FIELDS, Contact, ImpactProblem, all_finite
+from lawbench.core.problem import (
+    RESTITUTION_FIELDS,
+    UNIT_BAND,
+    Contact,
+    ImpactProblem,
+    all_finite,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -216,6 +222,20 @@ class ProblemBatch:
         else:
             G = np.swapaxes(self.Wn, 1, 2) @ self.solve_mass(self.Wn)
         return (G + np.swapaxes(G, 1, 2)) / 2
+
+    @cached_property
+    def in_own_units(self) -> bool:
+        """Whether every problem is solved in its own units (`ImpactProblem.units` is 1).
+
+        True when each problem's heaviest mass entry and its fastest speed (if any) lie within
+        `UNIT_BAND` of 1; a vectorized path holds then, and the rest go one by one.
+        """
+        mass = np.abs(np.einsum("kii->ki", self.M)).max(axis=1)
+        speed = np.abs(self.v).max(axis=1)
+        near = (mass >= 1.0 / UNIT_BAND) & (mass <= UNIT_BAND)
+        return bool(
+            (near & ((speed == 0.0) | ((speed >= 1.0 / UNIT_BAND) & (speed <= UNIT_BAND)))).all()
+        )
 
     @cached_property
     def un(self) -> np.ndarray:

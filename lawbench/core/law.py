@@ -67,6 +67,11 @@ class Law(ABC):
     takes_sparse: ClassVar[bool] = False
     # The roles the law plays in ``lawbench bench`` (`lawbench.studies.bench.ROLES`).
     bench_roles: ClassVar[tuple[str, ...]] = ()
+    # Whether the law's answer in other units of mass, velocity and time is its answer scaled:
+    # true of a law that reads no dimensional contact parameter but the stiffness and the gaps.
+    # `resolve` then solves a problem of extreme scale in units near it (`ImpactProblem.units`)
+    # and scales the answer back; a law that reads a damping solves in the problem's own units.
+    scale_free: ClassVar[bool] = True
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         """Give every law the wall-clock budget ``max_seconds`` (`lawbench.core.budget`)."""
@@ -148,20 +153,24 @@ class Law(ABC):
                     f"{DENSE_BYTES / 2**30:g} GiB): a law that takes sparse problems treats it"
                 )
             problem = problem.dense()
+        units = problem.units if self.scale_free else (1.0, 1.0, 1.0)
+        solved = problem if units == (1.0, 1.0, 1.0) else problem.in_units(*units)
         start = time.perf_counter()
         with budget.Budget.of(self.name, values), warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            if problem.closed_count == problem.m or self.follows_gaps:
-                outcome = self._resolve(problem, values)
-            elif problem.closed_count:
-                closed = problem.closed
+            if solved.closed_count == solved.m or self.follows_gaps:
+                outcome = self._resolve(solved, values)
+            elif solved.closed_count:
+                closed = solved.closed
                 outcome = _embed(
-                    self._resolve(problem.select_contacts(closed), values), closed, problem
+                    self._resolve(solved.select_contacts(closed), values), closed, solved
                 )
             else:
-                outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
+                outcome = Outcome.from_impulses(solved, np.zeros(solved.m))
                 outcome.diagnostics["formulation"] = "no closed contact"
         wall_time = time.perf_counter() - start
+        if solved is not problem:
+            outcome = _scaled_back(outcome, problem, units)
         if problem.Wt is not None and outcome.Pt.size == 0:
             outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
         _refuse_non_finite(self.name, outcome)
@@ -203,7 +212,9 @@ class Law(ABC):
 
         values = self.option_values(options)
         start = time.perf_counter()
-        Pn = self._resolve_batch(batch, values)
+        # Problems of extreme scale are rescaled one by one, by `resolve`.
+        scaled = self.scale_free and not batch.in_own_units
+        Pn = None if scaled else self._resolve_batch(batch, values)
         if Pn is not None:
             formulation = Pn[1]
             result = OutcomeBatch.from_impulses(batch, Pn[0], formulation=formulation)
@@ -243,6 +254,31 @@ def _refuse_non_finite(name: str, outcome: Outcome) -> None:
     for field in ("v_plus", "Pn", "Pt", "T_plus"):
         if not all_finite(np.asarray(getattr(outcome, field))):
             raise SolverFailure(f"{name}: non-finite {field} {getattr(outcome, field)}")
+
+
+def _scaled_back(
+    outcome: Outcome, problem: ImpactProblem, units: tuple[float, float, float]
+) -> Outcome:
+    """The outcome of ``problem`` from one solved in ``units`` of mass, velocity and time.
+
+    Velocities are multiplied by the velocity unit and impulses by the product of both, and
+    the energies are the problem's own. The path and the diagnostics stay in the units solved
+    in, which ``diagnostics['units']`` names.
+    """
+    mass, velocity, time = units
+    diagnostics = {
+        **outcome.diagnostics,
+        "units": {"mass": mass, "velocity": velocity, "time": time},
+    }
+    return Outcome.from_velocity(
+        problem,
+        outcome.v_plus * velocity,
+        outcome.Pn * (mass * velocity),
+        outcome.Pt * (mass * velocity),
+        status=outcome.status,
+        diagnostics=diagnostics,
+        path=outcome.path,
+    )
 
 
 def _embed(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outcome:

@@ -101,6 +101,21 @@ def largest(array: np.ndarray) -> float:
 # Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
 SOLVE_BLOCK = 256
 
+# A problem whose heaviest mass entry and fastest velocity component lie within this factor of
+# 1 (about 1e-9 to 1e9) is solved in its own units; beyond, in units near them
+# (`ImpactProblem.units`).
+UNIT_BAND = 2.0**30
+
+
+def binary_scale(size: float) -> float:
+    """The power of two nearest ``size`` (1 for zero or a non-finite size).
+
+    Multiplying by it is exact (no digit is rounded) wherever no number under- or overflows.
+    """
+    if not math.isfinite(size) or size <= 0.0:
+        return 1.0
+    return math.ldexp(1.0, round(math.log2(size)))
+
 
 def is_sparse(value: object) -> bool:
     """Whether ``value`` is a scipy.sparse matrix or array.
@@ -581,8 +596,10 @@ class ImpactProblem:
             normal = (self.Wn * self._mass_solved(self.Wn)).sum(axis=0)
             columns = (self.W * self.W).sum(axis=0)
         elif self.n <= SMALL:
-            # The Delassus matrix is cheap here and every law needs it: its diagonal serves.
-            normal, columns = self.delassus.diagonal(), None
+            # The Delassus matrix is cheap here and every law needs it: its diagonal serves
+            # (where M^-1 overflows, infinite entries, refused below).
+            with np.errstate(over="ignore"):
+                normal, columns = self.delassus.diagonal(), None
         else:
             normal, columns = np.einsum("ij,ij->j", self.Wn, self.solve_mass(self.Wn)), None
         # The squared Frobenius norm of W bounds its largest squared column: one product
@@ -593,12 +610,28 @@ class ImpactProblem:
             return
         if columns is None:
             columns = np.einsum("ij,ij->j", W, W)
-        scale = inverse_mass * float(columns.max())
-        for j in np.flatnonzero(normal <= 1e-12 * scale):
-            raise InvalidProblem(
-                f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 Wn[:, {j}]"
-                f" = {normal[j]:.3g}): a singular configuration"
-            )
+        # Each contact against the inverse masses of the coordinates its normal moves: a light
+        # body elsewhere (masses 1e-20 and 1 kg) makes no contact singular.
+        geometry = 1e-12 * float(columns.max())
+        for j in range(self.m):
+            if not normal[j] / self._inverse_mass_on(j, inverse_mass) > geometry:
+                raise InvalidProblem(
+                    f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 "
+                    f"Wn[:, {j}] = {normal[j]:.3g}): a singular configuration"
+                )
+
+    def _inverse_mass_on(self, j: int, inverse_mass: float) -> float:
+        """The largest diagonal entry of M^-1 over the coordinates contact j's normal moves.
+
+        ``inverse_mass`` (the largest over all) where M^-1's diagonal is not at hand.
+        """
+        diagonal = self.__dict__.get("_inverse_diagonal")
+        if diagonal is None and "_inverse" in self.__dict__:
+            diagonal = self._inverse.diagonal()
+        column = self.Wn[:, [j]].toarray().ravel() if self.sparse else self.Wn[:, j]
+        if diagonal is None or not column.any():
+            return inverse_mass
+        return float(diagonal[column != 0].max())
 
     @cached_property
     def frictional(self) -> bool:
@@ -768,6 +801,89 @@ class ImpactProblem:
             coefficients.setflags(write=False)
             self._restitutions[kind] = coefficients
         return coefficients
+
+    @cached_property
+    def units(self) -> tuple[float, float, float]:
+        """The units of mass, velocity and time a scale-free law solves this problem in.
+
+        Powers of two (`binary_scale`) near the heaviest diagonal entry of M and the fastest
+        component of v, or 1 for a scale within `UNIT_BAND` of 1; when one of them is not 1,
+        the time unit brings the stiffest contact's stiffness near 1 (the time of its
+        compression), else it is 1 too. Rescaling by them rounds nothing, and masses of
+        1e-308 kg or speeds of 1e-300 m/s come near 1, where the laws' linear algebra and
+        integrators neither under- nor overflow.
+
+        Raises
+        ------
+        InvalidProblem
+            When the impulse or energy unit these give, ``mass velocity`` or
+            ``mass velocity^2``, is not a positive double: an answer could not be scaled back.
+        """
+        mass = largest(np.abs(self.M.diagonal()))
+        speed = largest(np.abs(self.v))
+        mass_unit, velocity_unit = (
+            1.0 if 1.0 / UNIT_BAND <= size <= UNIT_BAND else binary_scale(size)
+            for size in (mass, speed)
+        )
+        energy = mass_unit * velocity_unit * velocity_unit
+        if not (mass_unit * velocity_unit > 0.0 and 0.0 < energy < math.inf):
+            raise InvalidProblem(
+                f"M (largest diagonal entry {mass:.3g}) and v (largest |v| {speed:.3g}) give "
+                f"impulses and energies beyond double precision (energy scale "
+                f"{mass * speed**2:.3g})"
+            )
+        if mass_unit == velocity_unit == 1.0:
+            return 1.0, 1.0, 1.0
+        # Compression time of a spring K d^p loaded by the unit mass at the unit speed:
+        # (m / (K v^(p - 1)))^(1 / (p + 1)), in base-2 logarithms to stay clear of overflow.
+        mass_log, velocity_log = math.log2(mass_unit), math.log2(velocity_unit)
+        time_log = min(
+            (mass_log - math.log2(c.stiffness) - (c.exponent - 1.0) * velocity_log)
+            / (c.exponent + 1.0)
+            for c in set(self.contacts)
+        )
+        return mass_unit, velocity_unit, math.ldexp(1.0, round(time_log))
+
+    def in_units(self, mass: float, velocity: float, time: float) -> ImpactProblem:
+        """The problem with masses, velocities and times in units ``mass``, ``velocity``, ``time``.
+
+        Lengths are then in units of ``velocity time``: M and v are divided by their units,
+        gaps by the length unit, and a stiffness (N/m^exponent = kg m^(1 - exponent) s^-2) is
+        multiplied by ``length^(exponent - 1) time^2 / mass``. A damping's unit depends on the
+        compliant model that reads it, so it is kept as given: the laws that read it solve in
+        the problem's own units (`lawbench.core.law.Law.scale_free`).
+
+        Raises
+        ------
+        InvalidProblem
+            When a number rescaled leaves double precision, naming it and the units.
+        """
+        length = velocity * time
+        length_log, time_log = math.log2(length), math.log2(time)
+        contacts, rescaled = [], {}
+        for contact in self.contacts:
+            if contact not in rescaled:
+                factor_log = (
+                    (contact.exponent - 1.0) * length_log + 2.0 * time_log - math.log2(mass)
+                )
+                stiffness = 2.0 ** (math.log2(contact.stiffness) + factor_log)
+                rescaled[contact] = dataclasses.replace(contact, stiffness=stiffness)
+            contacts.append(rescaled[contact])
+        try:
+            return ImpactProblem(
+                self.M / mass,
+                self.Wn,
+                self.v / velocity,
+                contacts,
+                self.Wt,
+                self.bodies,
+                self.gaps / length if self.gaps.any() else None,
+            )
+        except (InvalidProblem, OverflowError) as exc:
+            raise InvalidProblem(
+                f"in units of {mass:g} kg, {velocity:g} m/s and {time:g} s the problem cannot "
+                f"be solved: {exc}"
+            ) from None
 
     def select_contacts(self, mask: np.ndarray) -> ImpactProblem:
         """Return the problem restricted to the contacts where ``mask`` is true."""

@@ -32,6 +32,7 @@ import scipy.sparse
 from lawbench.core import budget
 from lawbench.core.errors import SolverFailure
 from lawbench.core.mechanics import project
+from lawbench.core.problem import binary_scale
 from lawbench.numerics.solvers import clarabel_settings
 
 NEWTON_STEPS = 30
@@ -92,7 +93,7 @@ def solve_cone_qp(
     # Scaled to unit magnitudes (by powers of two, exact): clarabel's tolerances are absolute
     # as well as relative, and a problem whose velocities are 1e-7 m/s ended 'Solved' with its
     # complementarity broken by half the approach speed. P = (s / g) P^ solves the scaled one.
-    g, s = _binary_scale(np.abs(G).max()), _binary_scale(np.abs(q).max())
+    g, s = binary_scale(np.abs(G).max()), binary_scale(np.abs(q).max())
     G, q = G / g, q / s
     # Contact j's slack -A P is (mu_j Pn_j, Pt_j), or (Pn_j, Pt_j) when it is frictionless.
     cols, values, cones = [], [], []
@@ -121,13 +122,6 @@ def solve_cone_qp(
         raise SolverFailure(f"clarabel status {status} after {solution.iterations} iterations")
     answer = (P if exact is None else exact) * (s / g)
     return ConeResult(answer, status, solution.iterations, exact is not None)
-
-
-def _binary_scale(size: float) -> float:
-    """The power of two nearest ``size`` (1 for zero or a non-finite size)."""
-    if not np.isfinite(size) or size <= 0.0:
-        return 1.0
-    return float(2.0 ** np.round(np.log2(size)))
 
 
 def split(x: np.ndarray, m: int, d: int) -> tuple[np.ndarray, np.ndarray]:

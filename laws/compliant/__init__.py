@@ -68,9 +68,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
-from lawbench.core.problem import ImpactProblem
+from lawbench.core.problem import ImpactProblem, all_finite
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.laws._claims import keeps_energy, never_creates_energy
@@ -102,6 +103,9 @@ class Compliant(Law):
         "motion closes it again"
     )
     follows_gaps = True
+    # Its damping's unit depends on the model (N s/m, N s/m^n or s/m): it solves in the
+    # problem's own units, which its integration scales by itself.
+    scale_free = False
     guarantees = (
         keeps_energy(
             "Brogliato 2010, compliant contacts; Hunt and Crossley 1975",
@@ -142,6 +146,13 @@ class Compliant(Law):
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        G = problem.contact_delassus if problem.frictional else problem.delassus
+        if not all_finite(G.diagonal()):
+            raise NotApplicable(
+                "compliant: integrates in the problem's own units (a damping's unit depends on "
+                "the model), and this problem's inverse effective masses overflow (largest "
+                "Delassus entry beyond 1.8e308): give it in units near its masses"
+            )
         integration = FrictionalIntegration if problem.frictional else Integration
         return integration(problem, options).run()
 
