@@ -101,6 +101,13 @@ def test_run_checks_on_a_problem_of_your_own():
             lambda: lawbench.save_problem(lawbench.CASES["three_ball_chain"].build(), None),
             "problem file: a path",
         ),
+        (lambda: lawbench.check_law(None), "law must be a law name"),
+        (lambda: lawbench.CASES.get(7), "case must be a case name"),
+        (lambda: lawbench.LAWS.get("newton").resolve(None), "problem must be an ImpactProblem"),
+        (lambda: lawbench.solve_batch("newton", "abc"), r"problems\[0\] is str"),
+        (lambda: lawbench.plot_outcome(None), "outcome must be an Outcome or a Trial"),
+        (lambda: lawbench.plot_path("x"), "outcome must be an Outcome or a Trial"),
+        (lambda: lawbench.plot_sweep("table", "x", "y"), "frame must be a pandas DataFrame"),
     ],
 )
 def test_a_wrong_argument_is_a_type_error_that_names_it(call, named):
@@ -119,3 +126,7 @@ def test_a_problem_with_a_vector_that_is_not_numeric_is_invalid_naming_it():
     """Not a bare ValueError from numpy: the field is named."""
     with pytest.raises(lawbench.InvalidProblem, match="v: not an array of numbers"):
         lawbench.ImpactProblem.from_arrays(np.eye(2), np.array([[-1.0], [1.0]]), v=["a", "b"])
+    with pytest.raises(lawbench.InvalidProblem, match="v: not an array of numbers"):
+        lawbench.ProblemBatch(np.eye(2), np.array([[-1.0], [1.0]]), "x", {})
+    with pytest.raises(lawbench.InvalidProblem, match=r"coefficients\['e'\]: not an array"):
+        lawbench.ProblemBatch(np.eye(2), np.array([[-1.0], [1.0]]), [[1.0, 0.0]], {"e": "a"})

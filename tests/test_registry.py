@@ -35,7 +35,7 @@ def test_a_module_with_a_missing_dependency_is_skipped_with_its_reason(tmp_path,
         "plugin_registry.REGISTRY.register(type('Entry', (), {'name': 'fine'})())\n"
     )
     (package / "heavy.py").write_text("import a_package_that_is_not_installed\n")
-    registry = Registry("law", "plugin_laws")
+    registry = Registry("law", "plugin_laws", object)
     holder = types.ModuleType("plugin_registry")
     holder.REGISTRY = registry
     monkeypatch.setitem(sys.modules, "plugin_registry", holder)

@@ -267,7 +267,7 @@ class _Studies(Registry[Study]):
         self._loaded = True
 
 
-STUDIES: _Studies = _Studies("study", "lawbench.cases")
+STUDIES: _Studies = _Studies("study", "lawbench.cases", Study)
 
 
 STUDIES.register(

@@ -39,12 +39,17 @@ _OVERFLOW = "M is too close to singular (its inverse overflows)"
 COEFFICIENTS = {"e": (0.0, 1.0), "e_newton": (0.0, 1.0), "e_poisson": (0.0, 1.0)}
 
 
-def _stack(name: str, value: object, shape: tuple[int, ...], batch: int | None) -> np.ndarray:
-    """``value`` as a float array (B, *shape); one array of ``shape`` serves every problem."""
+def _numbers(name: str, value: object) -> np.ndarray:
+    """``value`` as a float array; `InvalidProblem` naming ``name`` when it holds no numbers."""
     try:
-        array = np.asarray(value, dtype=float)
+        return np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
+
+
+def _stack(name: str, value: object, shape: tuple[int, ...], batch: int | None) -> np.ndarray:
+    """``value`` as a float array (B, *shape); one array of ``shape`` serves every problem."""
+    array = _numbers(name, value)
     # Before broadcasting: one array that serves every problem is checked once.
     finite = all_finite(array)
     if array.shape == shape and batch is not None:
@@ -85,7 +90,7 @@ class ProblemBatch:
     coefficients: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        v = np.asarray(self.v, dtype=float)
+        v = _numbers("v", self.v)
         if v.ndim != 2 or v.shape[0] < 1 or v.shape[1] < 1:
             raise InvalidProblem(f"v has shape {v.shape}, expected (B, n) with B, n >= 1")
         batch, n = v.shape
@@ -104,7 +109,7 @@ class ProblemBatch:
                 raise InvalidProblem(
                     f"unknown batch coefficient {name!r}; known: {', '.join(COEFFICIENTS)}"
                 )
-            array = np.broadcast_to(np.asarray(value, dtype=float), (batch, m))
+            array = np.broadcast_to(_numbers(f"coefficients[{name!r}]", value), (batch, m))
             low, high = COEFFICIENTS[name]
             # NaN fails both comparisons.
             if not (array.min() >= low and array.max() <= high):
@@ -166,6 +171,9 @@ class ProblemBatch:
         """Stack problems of one shape (frictionless, zero gaps)."""
         if not problems:
             raise InvalidProblem("an empty batch: give at least one problem")
+        for k, problem in enumerate(problems):
+            if not isinstance(problem, ImpactProblem):
+                raise TypeError(f"problems[{k}] is {type(problem).__name__}, not ImpactProblem")
         first = problems[0]
         for k, problem in enumerate(problems):
             if (problem.n, problem.m) != (first.n, first.m):

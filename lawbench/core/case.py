@@ -188,4 +188,4 @@ def exactly(params: Params, name: str, count: int, what: str) -> None:
         )
 
 
-CASES: Registry[Case] = Registry("case", "lawbench.cases")
+CASES: Registry[Case] = Registry("case", "lawbench.cases", Case)

@@ -133,6 +133,8 @@ class Law(ABC):
         SolverFailure
             When the numerical method fails or would return a non-finite number.
         """
+        if not isinstance(problem, ImpactProblem):
+            raise TypeError(f"problem must be an ImpactProblem, not {type(problem).__name__}")
         values = self.option_values(options)
         reason = self.tags.refusal(problem)
         if reason:
@@ -293,4 +295,4 @@ def _embed(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outc
     return dataclasses.replace(outcome, Pn=Pn, Pt=Pt)
 
 
-LAWS: Registry[Law] = Registry("law", "lawbench.laws")
+LAWS: Registry[Law] = Registry("law", "lawbench.laws", Law)

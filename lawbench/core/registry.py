@@ -56,11 +56,14 @@ class Registry(Mapping[str, Entry]):
         What the entries are, for messages.
     package : str
         Dotted name of the package whose modules register entries.
+    entry_type : type
+        The class of the entries: `get` passes one through and refuses any other non-name.
     """
 
-    def __init__(self, kind: str, package: str) -> None:
+    def __init__(self, kind: str, package: str, entry_type: type) -> None:
         self.kind = kind
         self.package = package
+        self.entry_type = entry_type
         self._entries: dict[str, Entry] = {}
         self.unavailable: dict[str, str] = {}
         self._loaded = False
@@ -129,10 +132,17 @@ class Registry(Mapping[str, Entry]):
         ------
         UnknownName
             For an unknown name; the message lists the known ones.
+        TypeError
+            For an argument that is neither a name nor an entry.
         """
-        if not isinstance(name, str):
+        if isinstance(name, str):
+            return self[name]
+        if isinstance(name, self.entry_type):
             return name
-        return self[name]
+        raise TypeError(
+            f"{self.kind} must be a {self.kind} name (str) or a {self.entry_type.__name__}, "
+            f"not {type(name).__name__}"
+        )
 
     def __getitem__(self, name: str) -> Entry:
         if name not in self._entries:

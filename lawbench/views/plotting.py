@@ -48,7 +48,12 @@ def _axes(ax: Axes | None) -> Axes:
 
 
 def _outcome(result: Outcome | Trial) -> Outcome:
-    return result.outcome if isinstance(result, Trial) else result
+    """The outcome of the argument ``outcome``: an `Outcome`, or a `Trial`'s."""
+    if isinstance(result, Trial):
+        return result.outcome
+    if not isinstance(result, Outcome):
+        raise TypeError(f"outcome must be an Outcome or a Trial, not {type(result).__name__}")
+    return result
 
 
 def plot_outcome(
@@ -166,6 +171,8 @@ def plot_sweep(
     InvalidProblem
         For a column the table does not have.
     """
+    if not isinstance(frame, pd.DataFrame):
+        raise TypeError(f"frame must be a pandas DataFrame, not {type(frame).__name__}")
     drawn = pd.DataFrame({"x": _column(frame, x), "y": _column(frame, y), "by": _column(frame, by)})
     ax = _axes(ax)
     for name, group in drawn.dropna().groupby("by", sort=True):
