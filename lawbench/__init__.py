@@ -54,6 +54,7 @@ _LAZY = {
     "load_run": "lawbench.studies.runfile",
     "plot_outcome": "lawbench.views.plotting",
     "plot_path": "lawbench.views.plotting",
+    "plot_profiles": "lawbench.views.plotting",
     "plot_sweep": "lawbench.views.plotting",
     "check_law": "lawbench.studies.conformance",
 }
@@ -111,6 +112,7 @@ __all__ = [
     "load_run",
     "plot_outcome",
     "plot_path",
+    "plot_profiles",
     "plot_sweep",
     "run_checks",
     "save_problem",

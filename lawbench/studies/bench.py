@@ -9,10 +9,17 @@ plain numpy enumeration of the same LCP's active sets, and Siconos numerics' Lem
 it is installed (``LAWBENCH_SICONOS_PYTHON``, default ``/usr/bin/python3`` with Debian's
 python3-siconos). Ratios, not absolute times, are what
 carry from one machine to another. This is a benchmark: nothing here asserts a time.
+
+`bench_problems` (``lawbench bench --problems DIR``) is the other bench: every law, and each
+method of a law with an option ``method``, on every problem file of a folder, one guarded row
+each (file, contacts, law, method, status, FC3D error, seconds), with Dolan and Moré's (2002)
+performance ratios (`performance_profiles`) and Siconos' NSGS as a peer where it is importable.
 """
 
 from __future__ import annotations
 
+import functools
+import importlib.util
 import math
 import os
 import platform
@@ -20,22 +27,27 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 import clarabel
 import numpy as np
+import pandas as pd
 import scipy.sparse
 
 from lawbench.core.batch import ProblemBatch
 from lawbench.core.case import CASES
-from lawbench.core.errors import InvalidProblem, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS
-from lawbench.core.problem import ImpactProblem
+from lawbench.core.outcome import Outcome
+from lawbench.core.problem import ImpactProblem, as_array
 from lawbench.core.registry import Registry
 from lawbench.core.trial import solve_batch
 from lawbench.numerics.chains import chain_problem
+from lawbench.numerics.gauss_seidel import local_order
 from lawbench.numerics.solvers import clarabel_settings, enumerate_lcp
+from lawbench.studies.guard import TIME_OUT, WALL_CLOCK, Guard, Result, alarm
 
 # The roles laws and scenes declare (``bench_roles``) to be the bench's subjects:
 ROLES = {
@@ -419,3 +431,232 @@ def report(quick: bool = False) -> str:
         *start_up(repeats),
     ]
     return "\n".join(lines)
+
+
+# ``lawbench bench --problems DIR``: every law (and method) on every problem file of a folder.
+
+# The extensions of the problem files read (`lawbench.files.problem_files.load_problem`).
+PROBLEM_SUFFIXES = (".json", ".npz", ".h5", ".hdf5")
+# A row solves its problem when its status is ok and, where it is measured, the FC3D error is
+# at most this (the threshold of Acary, Brémond and Huber's comparisons).
+SOLVED_FC3D = 1e-8
+COLUMNS = ("file", "contacts", "law", "method", "status", "fc3d_error", "seconds", "error")
+# The guard kills a worker that heeds neither its law's budget nor its alarm by this many times
+# the budget, plus a grace (a file read, a loop in compiled code).
+KILL_FACTOR, KILL_GRACE_S = 2.0, 2.0
+# Step bounds of a bench row: the wall-clock budget decides.
+MAX_STEPS = 10**9
+# Siconos' NSGS as a peer: its solver options (FC3D error and sweeps).
+SICONOS_TOL, SICONOS_SWEEPS = 1e-8, 100_000
+PEER = ("siconos", "nsgs")
+
+
+def problem_files(folder: str | Path) -> list[Path]:
+    """The problem files of ``folder`` (by extension, `PROBLEM_SUFFIXES`), sorted by name.
+
+    Raises
+    ------
+    InvalidProblem
+        For a folder that does not exist or holds no problem file.
+    """
+    where = Path(folder)
+    if not where.is_dir():
+        raise InvalidProblem(f"bench --problems {folder}: no such folder")
+    found = sorted(p for p in where.iterdir() if p.is_file() and p.suffix in PROBLEM_SUFFIXES)
+    if not found:
+        raise InvalidProblem(
+            f"bench --problems {folder}: no problem file ({', '.join(PROBLEM_SUFFIXES)}) in it"
+        )
+    return found
+
+
+def solvers(laws: Sequence[str] | None = None) -> list[tuple[str, str]]:
+    """``(law, method)`` of every law of ``laws`` (default every registered one).
+
+    A law with an option ``method`` gives one pair per choice, any other the method ''.
+    """
+    pairs = []
+    for name in laws or LAWS.names():
+        methods = [s.choices for s in LAWS[name].options if s.name == "method" and s.choices]
+        pairs += [(name, method) for method in (methods[0] if methods else ("",))]
+    return pairs
+
+
+def siconos_available() -> bool:
+    """Whether the ``siconos`` package (Siconos numerics' Python interface) is importable."""
+    return importlib.util.find_spec("siconos") is not None
+
+
+def status_of(error: BaseException) -> str:
+    """The status of a row whose solve raised ``error``."""
+    if isinstance(error, NotApplicable):
+        return "not applicable"
+    if isinstance(error, BudgetExceeded):
+        return "budget"
+    if isinstance(error, SolverFailure):
+        return "solver failure"
+    return "error"
+
+
+@functools.lru_cache(maxsize=1)
+def _loaded(path: str) -> ImpactProblem:
+    """The problem of ``path``, read once per worker for all the laws solved on it."""
+    from lawbench.files.problem_files import load_problem
+
+    return load_problem(path)
+
+
+def solve_file(path: str, law: str, method: str, seconds: float) -> dict[str, Any]:
+    """The row of ``law`` (with ``method``, '' for none) on the problem file ``path``.
+
+    The law gets ``seconds`` as its ``max_seconds``, under an `alarm` of as many seconds; its
+    step bounds are lifted to `MAX_STEPS`, so that time alone decides. Never raises: a failure
+    is the row's status and error.
+    """
+    from lawbench.files.problem_files import file_diagnostics
+
+    row: dict[str, Any] = dict.fromkeys(COLUMNS, math.nan)
+    row.update(file=Path(path).name, law=law, method=method, status="ok", error="")
+    try:
+        problem = _loaded(path)
+        row["contacts"] = problem.m
+        with alarm(seconds):
+            start = time.perf_counter()
+            outcome = _solve(problem, law, method, seconds)
+            row["seconds"] = time.perf_counter() - start
+        row["fc3d_error"] = file_diagnostics(path, outcome).get("fc3d_error", math.nan)
+    except Exception as exc:  # a row records its failure and the bench goes on
+        row["status"], row["error"] = status_of(exc), f"{type(exc).__name__}: {exc}"
+    return row
+
+
+def _solve(problem: ImpactProblem, law: str, method: str, seconds: float) -> Outcome:
+    """``law`` (or the Siconos peer) on ``problem`` within ``seconds``."""
+    if (law, method) == PEER:
+        return siconos_nsgs(problem)
+    options: dict[str, Any] = {"max_seconds": seconds}
+    if method:
+        options["method"] = method
+    if any(spec.name == "max_steps" for spec in LAWS[law].options):
+        options["max_steps"] = MAX_STEPS
+    return LAWS[law].resolve(problem, **options)
+
+
+def siconos_nsgs(problem: ImpactProblem) -> Outcome:
+    """Siconos numerics' ``fc3d_nsgs`` on the problem's local form (spatial, ``e = 0``).
+
+    ``W`` is the contact Delassus matrix and ``q = W.T v-`` in FCLIB's per-contact order,
+    solved to `SICONOS_TOL` within `SICONOS_SWEEPS` sweeps.
+
+    Raises
+    ------
+    NotApplicable
+        For a problem without spatial friction.
+    SolverFailure
+        When Siconos reports that it did not converge.
+    """
+    import siconos.numerics as sn
+
+    if not problem.frictional or problem.d != 2:
+        raise NotApplicable("siconos: fc3d_nsgs solves spatial frictional problems")
+    order = local_order(problem.m, problem.d)
+    W = np.asfortranarray(as_array(problem.contact_delassus)[np.ix_(order, order)])
+    q = np.asarray(problem.W.T @ problem.v)[order]
+    fcp = sn.FrictionContactProblem(3, problem.m, W, q, np.array(problem.mu))
+    options = sn.SolverOptions(sn.SICONOS_FRICTION_3D_NSGS)
+    options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = SICONOS_SWEEPS
+    options.dparam[sn.SICONOS_DPARAM_TOL] = SICONOS_TOL
+    r, u = np.zeros(q.size), np.zeros(q.size)
+    info = sn.fc3d_nsgs(fcp, r, u, options)
+    if info:
+        raise SolverFailure(f"siconos: fc3d_nsgs info {info}")
+    P = np.empty_like(r)
+    P[order] = r
+    return Outcome.from_impulses(problem, P[: problem.m], P[problem.m :])
+
+
+def bench_problems(
+    folder: str | Path, seconds: float, laws: Sequence[str] | None = None
+) -> tuple[pd.DataFrame, list[str]]:
+    """Every solver (`solvers`, and Siconos' NSGS where importable) on every file of ``folder``.
+
+    One row per file x law x method (`COLUMNS`), each solved in a guarded worker process
+    (`lawbench.studies.guard.Guard`, one at a time so that the times do not share the machine):
+    a row that runs out of time is a ``budget`` row, a damaged file gives ``error`` rows, and
+    neither stops the others. Returns the table and its notes.
+    """
+    files = problem_files(folder)
+    pairs = solvers(laws)
+    notes = [
+        f"budget {seconds:g} s per file and solver; solved: status ok and FC3D error "
+        f"<= {SOLVED_FC3D:g} where the file defines it"
+    ]
+    if siconos_available():
+        pairs.append(PEER)
+    else:
+        notes.append("Siconos numerics (python package siconos) not available: no peer column")
+    tasks = [(str(path), law, method) for path in files for law, method in pairs]
+    kill = KILL_FACTOR * seconds + KILL_GRACE_S
+    with Guard(1, kill) as guard:
+        handles = {guard.submit(solve_file, *task, seconds): task for task in tasks}
+        rows = [_guarded_row(guard.result(h), task, kill) for h, task in handles.items()]
+    return pd.DataFrame(rows, columns=list(COLUMNS)), notes
+
+
+def _guarded_row(result: Result, task: tuple[str, str, str], kill_s: float) -> dict[str, Any]:
+    """The row of a task: its own, or the guard's account of a worker it stopped or lost."""
+    if result.status == "ok":
+        return result.value
+    path, law, method = task
+    row: dict[str, Any] = dict.fromkeys(COLUMNS, math.nan)
+    status = "budget" if result.status == TIME_OUT else "error"
+    message = (
+        f"{WALL_CLOCK}: no answer within {kill_s:g} s"
+        if status == "budget"
+        else (f"{result.error_class}: {result.error_message}")
+    )
+    row.update(file=Path(path).name, law=law, method=method, status=status, error=message)
+    return row
+
+
+def solved(table: pd.DataFrame) -> pd.Series:
+    """Whether each row solved its problem (`SOLVED_FC3D`)."""
+    measured = table["fc3d_error"].notna()
+    return (table["status"] == "ok") & (~measured | (table["fc3d_error"] <= SOLVED_FC3D))
+
+
+def solver_label(law: str, method: str) -> str:
+    """A solver's name in summaries and profiles: the law, and its method when it has one."""
+    return f"{law} ({method})" if method else law
+
+
+def performance_profiles(table: pd.DataFrame) -> dict[str, np.ndarray]:
+    """Dolan and Moré's (2002) performance ratios, per solver sorted, one per problem.
+
+    ``r_ps = t_ps / min_s t_ps`` with ``t_ps`` the seconds of solver s on problem p where it
+    `solved` it, infinite otherwise; the profile ``rho_s(tau)`` is the fraction of the ratios
+    at most ``tau``, over the files that were read (a damaged file is no problem). Solvers that
+    solve no problem are left out.
+    """
+    frame = table[table["contacts"].notna()].assign(
+        solver=lambda f: [solver_label(*pair) for pair in zip(f["law"], f["method"], strict=True)],
+        time=lambda f: np.where(solved(f), f["seconds"], np.inf),
+    )
+    times = frame.pivot_table(index="file", columns="solver", values="time", aggfunc="min")
+    best = times.min(axis=1)
+    ratios = times.div(best.where(np.isfinite(best)), axis=0).fillna(np.inf)
+    return {s: np.sort(ratios[s].to_numpy()) for s in ratios if np.isfinite(ratios[s]).any()}
+
+
+def problems_summary(table: pd.DataFrame, notes: list[str]) -> str:
+    """Per solver: the files solved and the median seconds of those, then the notes."""
+    frame = table.assign(solved=solved(table))
+    lines = [f"{len(set(table['file']))} files, {len(table)} rows"]
+    for (law, method), rows in frame.groupby(["law", "method"], sort=False):
+        done = rows[rows["solved"]]
+        median = f", median {_time(done['seconds'].median())}" if len(done) else ""
+        statuses = ", ".join(f"{n} {s}" for s, n in rows["status"].value_counts().items())
+        lines.append(
+            f"  {solver_label(law, method):<28}solved {len(done)}/{len(rows)}{median} ({statuses})"
+        )
+    return "\n".join([*lines, *(f"note: {note}" for note in notes)])

@@ -55,6 +55,8 @@ EXIT_CODES = {
 }
 
 
+# Seconds one law may spend on one file of ``lawbench bench --problems``.
+PROBLEM_BUDGET_S = 60.0
 # Cells above which ``lawbench run`` asks for --yes.
 LARGE_GRID = 10_000
 # Cells of a large grid timed for the estimate of its duration.
@@ -441,9 +443,31 @@ def _inline_spec(args: argparse.Namespace) -> object:
 
 
 def _bench(args: argparse.Namespace) -> None:
-    from lawbench.studies.bench import report
+    if args.problems is None:
+        from lawbench.studies.bench import report
 
-    print(report(quick=args.quick))
+        print(report(quick=args.quick))
+        return
+    from lawbench.studies.bench import bench_problems, performance_profiles, problems_summary
+
+    out = output_file(args.out, "bench table")
+    if out.suffix.lower() != ".csv":
+        raise InvalidProblem(f"bench --out {args.out}: the table is CSV (.csv)")
+    laws = _names(args.laws, "--laws", LAWS)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InvalidProblem(f"bench --out {args.out}: cannot be written ({exc})") from None
+    table, notes = bench_problems(args.problems, args.max_seconds, None if laws == ["*"] else laws)
+    with out.open("w", encoding="utf-8") as handle:
+        handle.writelines(f"# {note}\n" for note in notes)
+        table.to_csv(handle, index=False)
+    from lawbench.views.plotting import plot_profiles
+
+    figure = out.with_suffix(".png")
+    plot_profiles(performance_profiles(table)).figure.savefig(figure, dpi=120)
+    print(problems_summary(table, notes))
+    print(f"table written to {out}, performance profiles to {figure}")
 
 
 def _regress(args: argparse.Namespace) -> None:
@@ -759,6 +783,28 @@ def build_parser() -> argparse.ArgumentParser:
         "bench", help="time the laws against clarabel and numpy called directly (ratios)"
     )
     bench.add_argument("--quick", action="store_true", help="fewer repetitions, smaller sizes")
+    bench.add_argument(
+        "--problems",
+        type=_path,
+        metavar="DIR",
+        help="instead: solve every problem file in DIR (FCLIB .hdf5/.h5, lawbench .json/.npz/.h5) "
+        "with every law and method, into a CSV table and performance profiles",
+    )
+    bench.add_argument("--laws", help="with --problems: comma-separated laws (default: every law)")
+    bench.add_argument(
+        "--out",
+        type=_path,
+        default="bench-problems.csv",
+        metavar="FILE",
+        help="with --problems: the CSV table; the profiles go beside it as a .png",
+    )
+    bench.add_argument(
+        "--max-seconds",
+        type=_seconds,
+        default=PROBLEM_BUDGET_S,
+        metavar="S",
+        help=f"with --problems: budget of one law on one file (default {PROBLEM_BUDGET_S:g})",
+    )
     bench.set_defaults(run=_bench)
     return parser
 

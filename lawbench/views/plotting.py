@@ -16,7 +16,7 @@ same colour here as in every figure of the report.
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -212,3 +212,44 @@ def _units(frame: pd.DataFrame) -> dict[str, str]:
         coordinates = case.coordinates(case.parameters())
         units |= {f"v_plus[{k}]": plots.unit(c) for k, c in enumerate(coordinates)}
     return units
+
+
+# One line style per method of a law, which keeps its colour.
+LINE_STYLES = ("-", "--", ":", "-.")
+
+
+def plot_profiles(ratios: Mapping[str, Sequence[float]], ax: Axes | None = None) -> Axes:
+    """Dolan and Moré's (2002) performance profiles: per solver, the share of problems solved.
+
+    Parameters
+    ----------
+    ratios : mapping of str to sequence of float
+        Per solver (``"LAW METHOD"``), its time over the fastest solver's on each problem, inf
+        where it did not solve it (`lawbench.studies.bench.performance_profiles`).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; a new figure's axes when None.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        A step line per solver: the share of problems it solves within a factor tau of the
+        fastest, tau on a log axis.
+    """
+    ax = _axes(ax)
+    finite = [r[np.isfinite(r)] for r in map(np.asarray, ratios.values())]
+    right = 2.0 * max((float(r.max()) for r in finite if r.size), default=1.0)
+    seen: dict[str, int] = {}
+    for (solver, r), solved in zip(ratios.items(), finite, strict=True):
+        taus = np.concatenate([[1.0], np.sort(solved), [right]])
+        shares = np.concatenate([[0.0], np.arange(1, solved.size + 1), [solved.size]])
+        law = solver.split(" ")[0]
+        seen[law] = seen.get(law, -1) + 1
+        style = {"color": plots.law_style(law)["color"], "linestyle": LINE_STYLES[seen[law] % 4]}
+        ax.step(taus, shares / len(r), where="post", label=solver, **style)
+    plots.log_scale(ax, "x")
+    ax.set_xlabel("tau: time over the fastest solver's")
+    ax.set_ylabel("share of problems solved within tau")
+    ax.set_ylim(0.0, 1.05)
+    if ratios:
+        ax.legend(fontsize="small", loc="lower right")
+    return ax

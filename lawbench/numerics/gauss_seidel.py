@@ -1,0 +1,362 @@
+"""Coulomb's law in the impulses by nonsmooth Gauss-Seidel, each contact solved exactly.
+
+The problem is the one of `lawbench.numerics.cones`: find ``P`` with, per contact j,
+``K_j ∋ P_j _|_ uhat_j ∈ K*_j``, ``u = G P + q``, ``uhat_j = (un_j + mu_j |ut_j|, ut_j)``,
+``K_j = {|Pt_j| <= mu_j Pn_j}`` (De Saxce and Feng 1991); ``G`` and ``q`` in lawbench's order
+(the m normal components, then contact j's tangential ones at ``m + j*d ... m + j*d + d - 1``).
+
+Nonsmooth Gauss-Seidel (Jean, CMAME 177, 1999; Acary, Brémond and Huber, "On solving contact
+problems with Coulomb friction: formulations and numerical comparisons", 2018, section 4.1;
+Siconos' ``fc3d_nsgs``) sweeps the contacts in order; contact j's local problem, the others
+fixed, is ``u_j = W P_j + b`` with ``W = G_jj`` (its diagonal block) and ``b`` the rest of
+``(G P + q)_j``, and is solved exactly (`solve_contact`) by trying its three states in turn:
+
+- take-off: ``P_j = 0``, the solution exactly when ``b_n >= 0``;
+- stick: ``W P_j = -b``, the solution when it lies in the cone;
+- slip: ``un_j = 0``, ``Pt_j = -mu_j Pn_j e`` with ``e`` the unit slip direction, so that
+  ``Pn_j = -b_n / (W_nn - mu_j W_nt e)``. In the plane ``e = +-1`` (closed form). In space ``e``
+  is ``(cos t, sin t)``, and ``ut_j`` parallel to ``e`` is a trigonometric polynomial of degree
+  two in the slip angle ``t``: its roots are those of a quartic in ``z = exp(i t)`` on the unit
+  circle (companion matrix), refined by Newton's method on the angle. A slip must have
+  ``Pn_j > 0`` and ``ut_j . e >= 0``; when several roots qualify (strong normal-tangential
+  coupling gives several local solutions) the one nearest the current impulse is kept.
+
+A contact with ``mu_j = 0`` has the scalar projection ``Pn_j = max(-b_n / W_nn, 0)``. A local
+problem none of whose states qualifies (a singular block, or rounding at a state's boundary) is
+solved by Siconos' fallback, the projection iteration
+``P_j <- proj_K(P_j - (u_j + (mu_j |ut_j|, 0)) / W_nn)`` (Acary et al. 2018, eq. 4.4).
+
+Sweeps go on until the FC3D error (`lawbench.core.mechanics.fc3d_error`) is at most ``tol``. It
+costs about as much as a sweep, so, like Siconos' light-then-full evaluation, it is computed
+when the relative change of ``P`` over a sweep falls below a gate (``tol`` at first, lowered by
+the ratio of the error found to ``tol``), and every `CHECK_EVERY` sweeps. Each sweep spends one
+step of the solve's budget (`lawbench.core.budget`), so the loop ends at the law's ``max_steps``
+or ``max_seconds``.
+
+The per-contact kernel and the sweep are compiled by numba when it is installed
+(``pip install 'lawbench[fast]'``); the same functions run as plain Python without it.
+``G`` may be dense or scipy.sparse: it is held in compressed rows, so a sweep costs time
+proportional to its non-zero entries.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+import numpy as np
+import scipy.sparse
+
+from lawbench.core import budget
+from lawbench.core.mechanics import fc3d_error, project
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+try:
+    import numba
+except ImportError:  # the optional extra 'fast' is not installed: plain Python
+    numba = None
+
+
+def _compiled(function: _F) -> _F:
+    """``function`` compiled by numba (nopython mode) when it is installed, else itself."""
+    if numba is None:
+        return function
+    return numba.njit(cache=True)(function)
+
+
+COMPILED = numba is not None
+# A block whose condition number exceeds this has no reliable stick solution.
+SINGULAR = 1e12
+# Newton steps at most refining a root of the slip angle (a root of the quartic off the unit
+# circle gives a start that is no root), and the relative misalignment of the slip direction that
+# still counts as a root.
+ANGLE_STEPS, ALIGNED = 50, 1e-8
+# Sweeps between two evaluations of the FC3D error while the change of P stays above the gate.
+CHECK_EVERY = 10
+# Projection steps of the fallback local solver.
+FALLBACK_STEPS = 200
+TINY = np.finfo(float).tiny
+
+_project = _compiled(project)
+
+
+@dataclass(frozen=True)
+class GaussSeidelResult:
+    """Impulses ``P`` (lawbench's order), the sweeps done and the FC3D error of ``P``."""
+
+    P: np.ndarray
+    sweeps: int
+    error: float
+
+
+def local_order(m: int, d: int) -> np.ndarray:
+    """Positions in lawbench's order of FCLIB's per-contact order (n, t1[, t2]) of each contact."""
+    tangential = m + np.arange(m)[:, None] * d + np.arange(d)
+    return np.column_stack([np.arange(m), tangential]).ravel()
+
+
+def error_of(G: Any, q: np.ndarray, mu: np.ndarray, d: int, P: np.ndarray) -> float:
+    """The FC3D error of ``P`` (lawbench's order) on ``G``, ``q`` (dense or sparse ``G``)."""
+    order = local_order(len(mu), d)
+    W = scipy.sparse.csr_matrix(G)[order][:, order]
+    return fc3d_error(W, q[order], mu, P[order])
+
+
+@_compiled
+def _angle_terms(W: np.ndarray, b: np.ndarray, mu: float) -> tuple[np.ndarray, ...]:
+    """``A``, ``B``, ``C`` of ``V(t) = A + B cos t + C sin t = (W_nn - mu W_nt e) ut`` (spatial)."""
+    bn, bt, wnt = b[0], b[1:], W[0, 1:]
+    A = -bn * W[1:, 0] + W[0, 0] * bt
+    B = mu * (bn * W[1:, 1] - bt * wnt[0])
+    C = mu * (bn * W[1:, 2] - bt * wnt[1])
+    return A, B, C
+
+
+@_compiled
+def _refined(A: np.ndarray, B: np.ndarray, C: np.ndarray, angle: float) -> np.ndarray:
+    """The unit direction at the root of ``e x V(t)`` Newton's method reaches from ``angle``."""
+    for _ in range(ANGLE_STEPS):
+        c, s = np.cos(angle), np.sin(angle)
+        V, dV = A + B * c + C * s, C * c - B * s
+        h = c * V[1] - s * V[0]
+        slope = -s * V[1] - c * V[0] + c * dV[1] - s * dV[0]
+        if slope == 0.0:
+            break
+        angle -= h / slope
+        if abs(h / slope) <= 1e-15:
+            break
+    return np.array([np.cos(angle), np.sin(angle)])
+
+
+@_compiled
+def _slip_directions(W: np.ndarray, b: np.ndarray, mu: float) -> np.ndarray:
+    """Every candidate unit slip direction ``e`` (rows): ``+1`` and ``-1`` in the plane.
+
+    In space the roots in the slip angle ``t`` of ``h(t) = e x V(t)`` (`_angle_terms`).
+    """
+    if b.size == 2:
+        return np.array([[1.0], [-1.0]])
+    A, B, C = _angle_terms(W, b, mu)
+    # 4 z^2 h(t) with cos t = (z + 1/z) / 2, sin t = (z - 1/z) / 2i: a quartic in z.
+    twist = C[1] - B[0]
+    coefficients = np.array(
+        [
+            complex(B[1] + C[0], -twist),
+            complex(2.0 * A[1], 2.0 * A[0]),
+            complex(2.0 * (B[1] - C[0]), 0.0),
+            complex(2.0 * A[1], -2.0 * A[0]),
+            complex(B[1] + C[0], twist),
+        ]
+    )
+    scale = np.abs(coefficients).max()
+    if scale == 0.0:
+        return np.zeros((0, 2))
+    roots = np.roots(coefficients / scale)
+    directions = np.empty((roots.size, 2))
+    for k in range(roots.size):
+        directions[k] = _refined(A, B, C, np.angle(roots[k]))
+    return directions
+
+
+@_compiled
+def _slip_along(W: np.ndarray, b: np.ndarray, mu: float, e: np.ndarray) -> np.ndarray:
+    """The slipping impulse along the unit direction ``e``, or an empty array if it is none.
+
+    ``Pn = -b_n / (W_nn - mu W_nt e) > 0``, ``Pt = -mu Pn e``, and ``ut`` along ``+e``.
+    """
+    denominator = W[0, 0] - mu * np.dot(W[0, 1:], e)
+    if denominator <= 0.0:
+        return np.zeros(0)
+    P = np.empty(b.size)
+    P[0] = -b[0] / denominator
+    P[1:] = -mu * P[0] * e
+    ut = W[1:] @ P + b[1:]
+    along = np.dot(ut, e)
+    across = np.linalg.norm(ut - along * e)
+    if along < 0.0 or across > ALIGNED * (np.linalg.norm(ut) + np.abs(b).max()):
+        return np.zeros(0)
+    return P
+
+
+@_compiled
+def _slip(W: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray) -> np.ndarray:
+    """The slipping impulse, or an empty array when no direction qualifies.
+
+    In space first the root Newton's method reaches from the current slip direction; else,
+    and in the plane, the qualifying slip nearest ``current``.
+    """
+    speed = np.linalg.norm(current[1:])
+    if b.size == 3 and speed > 0.0:
+        A, B, C = _angle_terms(W, b, mu)
+        warm = _slip_along(W, b, mu, _refined(A, B, C, np.arctan2(-current[2], -current[1])))
+        if warm.size:
+            return warm
+    best, distance = np.zeros(0), np.inf
+    directions = _slip_directions(W, b, mu)
+    for k in range(directions.shape[0]):
+        P = _slip_along(W, b, mu, directions[k])
+        if P.size and np.linalg.norm(P - current) < distance:
+            best, distance = P, np.linalg.norm(P - current)
+    return best
+
+
+@_compiled
+def _projected(W: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray) -> np.ndarray:
+    """The fallback: projection steps ``P <- proj_K(P - uhat / W_nn)`` from ``current``."""
+    P = current.copy()
+    rho = 1.0 / max(W[0, 0], TINY)
+    for _ in range(FALLBACK_STEPS):
+        u = W @ P + b
+        normal, tangential = _project(
+            P[0] - rho * (u[0] + mu * np.linalg.norm(u[1:])), P[1:] - rho * u[1:], mu
+        )
+        P[0], P[1:] = normal, tangential
+    return P
+
+
+@_compiled
+def solve_contact(
+    W: np.ndarray, inverse: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray
+) -> np.ndarray:
+    """One contact's impulse for its local velocity ``u = W P + b``: take-off, stick or slip.
+
+    Parameters
+    ----------
+    W : array (1 + d, 1 + d)
+        The contact's block of the Delassus matrix, in the order (n, t1[, t2]).
+    inverse : array (1 + d, 1 + d)
+        ``W``'s inverse, or NaN for a block too close to singular to stick reliably.
+    b : array (1 + d,)
+        The rest of the contact's local velocity, same order.
+    mu : float
+        Friction coefficient, >= 0.
+    current : array (1 + d,)
+        The current impulse: where the slip is not unique the one nearest it is kept, and the
+        fallback starts from it.
+
+    Returns
+    -------
+    array (1 + d,)
+        ``P`` with ``K ∋ P _|_ (un + mu |ut|, ut) ∈ K*`` (the module's docstring gives the
+        states and their sources).
+    """
+    P = np.zeros(b.size)
+    if b[0] >= 0.0:
+        return P
+    if mu == 0.0:
+        if W[0, 0] > 0.0:
+            P[0] = -b[0] / W[0, 0]
+        return P
+    if np.isfinite(inverse[0, 0]):
+        stick = -(inverse @ b)
+        if stick[0] > 0.0 and np.linalg.norm(stick[1:]) <= mu * stick[0]:
+            return stick
+    slip = _slip(W, b, mu, current)
+    if slip.size:
+        return slip
+    return _projected(W, b, mu, current)
+
+
+@_compiled
+def _sweep(
+    indptr: np.ndarray,
+    indices: np.ndarray,
+    data: np.ndarray,
+    blocks: np.ndarray,
+    inverses: np.ndarray,
+    q: np.ndarray,
+    mu: np.ndarray,
+    P: np.ndarray,
+) -> float:
+    """One Gauss-Seidel sweep over the contacts in place (FCLIB's order); ``|change of P|^2``."""
+    size = blocks.shape[1]
+    change = 0.0
+    for j in range(mu.size):
+        start = j * size
+        b = np.empty(size)
+        for a in range(size):
+            low, high = indptr[start + a], indptr[start + a + 1]
+            b[a] = q[start + a] + np.dot(data[low:high], P[indices[low:high]])
+        old = P[start : start + size].copy()
+        b -= blocks[j] @ old
+        new = solve_contact(blocks[j], inverses[j], b, mu[j], old)
+        P[start : start + size] = new
+        change += np.sum((new - old) ** 2)
+    return change
+
+
+def _blocks(W: scipy.sparse.csr_matrix, m: int, size: int) -> np.ndarray:
+    """The diagonal blocks (m, size, size) of ``W`` in FCLIB's order."""
+    first = np.arange(m)[:, None, None] * size
+    rows = first + np.arange(size)[:, None]
+    columns = first + np.arange(size)[None, :]
+    rows, columns = np.broadcast_arrays(rows, columns)
+    return np.asarray(W[rows.ravel(), columns.ravel()]).reshape(m, size, size).copy()
+
+
+def inverses(blocks: np.ndarray) -> np.ndarray:
+    """The inverse of each block, NaN for a block whose condition number exceeds `SINGULAR`."""
+    regular = np.linalg.cond(blocks) < SINGULAR
+    found = np.full_like(blocks, np.nan)
+    found[regular] = np.linalg.inv(blocks[regular])
+    return found
+
+
+def solve_nsgs(
+    G: Any, q: np.ndarray, mu: np.ndarray, d: int, tol: float, start: np.ndarray | None = None
+) -> GaussSeidelResult:
+    """Coulomb's law ``K ∋ P _|_ uhat ∈ K*`` by nonsmooth Gauss-Seidel (module docstring).
+
+    Parameters
+    ----------
+    G : array or scipy.sparse matrix (m*(1+d), m*(1+d))
+        The contact Delassus matrix, lawbench's order.
+    q : array (m*(1+d),)
+        Local velocity without impulses (restitution included), same order.
+    mu : array (m,)
+        Friction coefficients, >= 0.
+    d : int
+        Tangential directions per contact (1 planar, 2 spatial).
+    tol : float
+        The FC3D error at which the sweeps stop.
+    start : array (m*(1+d),), optional
+        Initial impulses (zero by default).
+
+    Returns
+    -------
+    GaussSeidelResult
+        The impulses, the sweeps and their FC3D error. The error exceeds ``tol`` only when a
+        sweep left ``P`` unchanged (the iteration is stationary).
+
+    Raises
+    ------
+    BudgetExceeded
+        When the solve's budget (steps: sweeps, or seconds) runs out first.
+    """
+    m, size = len(mu), 1 + d
+    order = local_order(m, d)
+    W = scipy.sparse.csr_matrix(G, dtype=float)[order][:, order]
+    W.sort_indices()
+    local_q = np.ascontiguousarray(np.asarray(q, dtype=float)[order])
+    mu = np.ascontiguousarray(mu, dtype=float)
+    blocks = _blocks(W, m, size)
+    inverse = inverses(blocks)
+    P = np.zeros(m * size) if start is None else np.asarray(start, dtype=float)[order]
+    spend, sweeps, gate, error, note = budget.current(), 0, tol, np.inf, ""
+    while True:
+        spend.step("Gauss-Seidel sweeps", note)
+        change = _sweep(W.indptr, W.indices, W.data, blocks, inverse, local_q, mu, P)
+        sweeps += 1
+        light = np.sqrt(change) / max(float(np.linalg.norm(P)), TINY)
+        if light <= gate or sweeps % CHECK_EVERY == 0:
+            error = fc3d_error(W, local_q, mu, P)
+            if error <= tol or change == 0.0:
+                break
+            # The error is about proportional to the change: wait until it should be at tol.
+            gate = min(gate, light * tol / error)
+        note = f"last change of P {light:.3g}, last FC3D error {error:.3g}, tolerance {tol:g}"
+    answer = np.empty_like(P)
+    answer[order] = P
+    return GaussSeidelResult(answer, sweeps, error)

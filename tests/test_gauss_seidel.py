@@ -1,0 +1,164 @@
+"""Moreau's law by nonsmooth Gauss-Seidel with an exact solver per contact (method 'nsgs').
+
+Sources: Jean (CMAME 177, 1999) for the method; Acary, Brémond and Huber (2018), "On solving
+contact problems with Coulomb friction: formulations and numerical comparisons", for the local
+problem's states and the FC3D error; De Saxce and Feng (1991) for Coulomb's law in the modified
+velocity, ``K ∋ P _|_ (un + mu |ut|, ut) ∈ K*``.
+"""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse
+
+import lawbench
+from lawbench.core.budget import Budget
+from lawbench.core.case import CASES
+from lawbench.core.errors import BudgetExceeded, InvalidProblem
+from lawbench.files.fclib import fclib_diagnostics, read_fclib
+from lawbench.numerics.gauss_seidel import error_of, solve_nsgs
+
+pytest.importorskip("h5py")
+
+MOREAU = lawbench.LAWS.get("moreau")
+FCLIB = sorted((Path(__file__).parent / "data" / "fclib").glob("*.hdf5"))
+FRICTIONAL = [name for name, case in CASES.items() if case.requires.friction]
+# Scenes where Coulomb's law has several solutions: both methods must solve it, each its own.
+SEVERAL_SOLUTIONS = {
+    ("billiard", 1.0): "the cue ball either stops both balls by friction or passes between "
+    "them; both satisfy De Saxce's conditions to rounding",
+}
+
+
+def with_friction(name, mu):
+    """The scene built with every friction coefficient it has set to ``mu``."""
+    case = CASES[name]
+    return case.build(**{p.name: mu for p in case.params if p.name.split("_")[0] == "mu"})
+
+
+def impulses(outcome):
+    return np.concatenate([outcome.Pn, outcome.Pt])
+
+
+def local_problem(problem):
+    """``G``, ``q`` (restitution of the unilateral rule included), mu and d of Moreau's law."""
+    q = problem.W.T @ problem.v
+    q[: problem.m] += problem.restitution("kinematic") * np.minimum(problem.un, 0.0)
+    return problem.contact_delassus, q, problem.mu, problem.d
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.3, 1.0])
+@pytest.mark.parametrize("name", FRICTIONAL)
+def test_nsgs_agrees_with_the_fixed_point_on_the_frictional_scenes(name, mu):
+    """Both methods solve the same law (De Saxce and Feng 1991): the same impulses to 1e-10,
+    or, where the law has several solutions, two answers that each satisfy it.
+    """
+    problem = with_friction(name, mu)
+    fixed_point = impulses(MOREAU.resolve(problem))
+    nsgs = impulses(MOREAU.resolve(problem, method="nsgs"))
+    scale = max(np.abs(fixed_point).max(), 1e-300)
+    if (name, mu) in SEVERAL_SOLUTIONS:
+        G, q, mus, d = local_problem(problem)
+        assert error_of(G, q, mus, d, fixed_point) <= 1e-10
+        assert error_of(G, q, mus, d, nsgs) <= 1e-10
+        assert np.abs(nsgs - fixed_point).max() > 1e-3 * scale
+        return
+    np.testing.assert_allclose(nsgs, fixed_point, rtol=0, atol=1e-10 * scale)
+
+
+@pytest.mark.parametrize("path", FCLIB, ids=lambda path: path.stem)
+def test_nsgs_solves_the_committed_fclib_files(path):
+    """The FC3D error on the file's own W and q (Acary, Brémond and Huber 2018) is <= 1e-8."""
+    outcome = MOREAU.resolve(read_fclib(path), method="nsgs")
+    assert fclib_diagnostics(path, outcome)["fc3d_error"] <= 1e-8
+    assert outcome.diagnostics["formulation"].startswith("NSGS")
+    assert outcome.diagnostics["sweeps"] >= 1
+
+
+# One contact, by hand. Planar: W = [[2, 1/2], [1/2, 1]], mu = 1/2; W^-1 = [[1, -1/2], [-1/2,
+# 2]] / (7/4). Stick at b = (-1, -1/10): P = -W^-1 b = (19/35, -6/35), |Pt| <= Pn / 2. Slip at
+# b = (-1, -2): the stick answer (0, 2) leaves the cone; with ut < 0, Pt = Pn / 2, so
+# un = (2 + 1/4) Pn - 1 = 0 gives P = (4/9, 2/9) and ut = 1/2 4/9 + 2/9 - 2 = -14/9 < 0.
+# Spatial: the same block with a decoupled second tangent gives the same slip (and Pt2 = 0); an
+# isotropic block diag(2, 1, 1) slips against bt = (3, 4): Pn = 1/2, Pt = -(1/4) (3, 4) / 5.
+PLANAR = np.array([[2.0, 0.5], [0.5, 1.0]])
+COUPLED = np.array([[2.0, 0.5, 0.0], [0.5, 1.0, 0.0], [0.0, 0.0, 1.0]])
+ISOTROPIC = np.diag([2.0, 1.0, 1.0])
+ONE_CONTACT = {
+    "planar take-off": (PLANAR, [0.3, -1.0], 0.5, [0.0, 0.0]),
+    "planar stick": (PLANAR, [-1.0, -0.1], 0.5, [19 / 35, -6 / 35]),
+    "planar slip": (PLANAR, [-1.0, -2.0], 0.5, [4 / 9, 2 / 9]),
+    "planar frictionless": (PLANAR, [-1.0, -2.0], 0.0, [0.5, 0.0]),
+    "spatial take-off": (ISOTROPIC, [0.2, 1.0, 1.0], 0.5, [0.0, 0.0, 0.0]),
+    "spatial stick": (ISOTROPIC, [-1.0, 0.1, -0.2], 0.5, [0.5, -0.1, 0.2]),
+    "spatial slip": (ISOTROPIC, [-1.0, 3.0, 4.0], 0.5, [0.5, -0.15, -0.2]),
+    "spatial coupled slip": (COUPLED, [-1.0, -2.0, 0.0], 0.5, [4 / 9, 2 / 9, 0.0]),
+    "spatial frictionless": (ISOTROPIC, [-1.0, 3.0, 4.0], 0.0, [0.5, 0.0, 0.0]),
+}
+
+
+@pytest.mark.parametrize("case", ONE_CONTACT)
+def test_one_contact_is_solved_exactly_in_each_state(case):
+    """Take-off, stick and slip of one contact (Acary, Brémond and Huber 2018, section 4.1)
+    against the hand calculation above; one sweep solves it and the second confirms it.
+    """
+    W, b, mu, expected = ONE_CONTACT[case]
+    result = solve_nsgs(W, np.array(b), np.array([mu]), len(b) - 1, 1e-12)
+    np.testing.assert_allclose(result.P, expected, rtol=0, atol=1e-14)
+    assert result.sweeps <= 2
+    assert result.error <= 1e-15
+
+
+def test_a_sparse_delassus_matrix_gives_the_dense_answer():
+    """The sweep reads G's non-zero entries only: dense and CSR agree to rounding."""
+    G, q, mu, d = local_problem(with_friction("disk_ball", 0.3))
+    dense = solve_nsgs(G, q, mu, d, 1e-12)
+    sparse = solve_nsgs(scipy.sparse.csr_matrix(G), q, mu, d, 1e-12)
+    np.testing.assert_allclose(sparse.P, dense.P, rtol=0, atol=1e-14)
+    assert sparse.sweeps == dense.sweeps
+
+
+def test_the_budget_stops_the_sweeps():
+    """A problem that needs tens of sweeps stops at a bound of 5 sweeps, or of 1 ms, with
+    `BudgetExceeded` naming the bound (lawbench.core.budget).
+    """
+    problem = read_fclib(next(path for path in FCLIB if path.stem.startswith("Box_Stacks")))
+    with pytest.raises(BudgetExceeded, match="5 Gauss-Seidel sweeps") as raised:
+        MOREAU.resolve(problem, method="nsgs", max_steps=5)
+    assert raised.value.budget == "max_steps"
+    G, q, mu, d = local_problem(problem)
+    with Budget("moreau", max_seconds=1e-3), pytest.raises(BudgetExceeded) as raised:
+        solve_nsgs(G, q, mu, d, 0.0)
+    assert raised.value.budget == "max_seconds"
+
+
+def test_nsgs_refuses_the_relaxed_cone():
+    """Anitescu's relaxation (friction 'relaxed') is the fixed point's convex problem only."""
+    with pytest.raises(InvalidProblem, match="method 'nsgs'"):
+        MOREAU.resolve(with_friction("rocking_block", 0.3), method="nsgs", friction="relaxed")
+
+
+PLAIN_PYTHON = """
+import sys
+sys.modules["numba"] = None
+import numpy as np
+from lawbench.numerics import gauss_seidel
+assert not gauss_seidel.COMPILED
+G = np.array({G})
+print(gauss_seidel.solve_nsgs(G, np.array({q}), np.array({mu}), 2, 1e-12).P.tolist())
+"""
+
+
+def test_plain_python_runs_the_same_sweeps():
+    """Without numba the same functions run uncompiled and give the same impulses."""
+    problem = with_friction("billiard", 0.3)
+    G, q, mu, d = local_problem(problem)
+    script = PLAIN_PYTHON.format(G=G.tolist(), q=q.tolist(), mu=mu.tolist())
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    plain = np.array(json.loads(done.stdout))
+    np.testing.assert_allclose(plain, solve_nsgs(G, q, mu, d, 1e-12).P, rtol=0, atol=1e-14)
