@@ -102,8 +102,11 @@ def _sticking_ratio(p: Params) -> tuple[float, float]:
     """Impulses ``(pn, pt)`` that give ``un+ = -e un-`` and ``ut+ = 0`` (Cramer's rule)."""
     un, ut, g_nn, g_nt, g_tt = _rates(p)
     rhs_n, rhs_t = -(1 + p["e"]) * un, -ut
+    # In units of the rod's mass (m G is dimensionless), where the determinant cannot underflow.
+    m = p["mass"]
+    g_nn, g_nt, g_tt = g_nn * m, g_nt * m, g_tt * m
     det = g_nn * g_tt - g_nt * g_nt
-    return (rhs_n * g_tt - g_nt * rhs_t) / det, (g_nn * rhs_t - g_nt * rhs_n) / det
+    return m * (rhs_n * g_tt - g_nt * rhs_t) / det, m * (g_nn * rhs_t - g_nt * rhs_n) / det
 
 
 def whittaker_modes(p: Params) -> list[np.ndarray]:

@@ -300,7 +300,24 @@ def _resolve_friction(
     q[:m] += restitution
     solve = _gauss_seidel if options["method"] == "nsgs" else _fixed_point
     P, diagnostics = solve(G, q, mu, d, options)
+    _refuse_approaching(G @ P + q, m, options["tol"], float(np.abs(q).max()))
     return Outcome.from_impulses(problem, P[:m], P[m:], diagnostics=diagnostics)
+
+
+def _refuse_approaching(u: np.ndarray, m: int, tol: float, scale: float) -> None:
+    """Raise `SolverFailure` where a contact still approaches after the impact.
+
+    The normal law holds ``un+ + E r >= 0`` (``u``'s first m entries); an answer far below,
+    by more than ``sqrt(tol)`` of the largest local velocity, is rounding's: with ``mu`` near
+    1e300 the modified velocity ``un + mu |ut|`` loses ``un`` entirely, and a zero impulse
+    passes the cone conditions while the contact goes on approaching.
+    """
+    j = int(np.argmin(u[:m]))
+    if u[j] < -(tol**0.5) * scale:
+        raise SolverFailure(
+            f"moreau: contact {j} still approaches after the impact (un+ + e r = {u[j]:.3g}): "
+            "the cone conditions hold only to rounding here"
+        )
 
 
 def _fixed_point(

@@ -87,14 +87,24 @@ def friction_cone(trial: Trial) -> tuple:
     problem, outcome = trial.problem, trial.outcome
     if problem.Wt is None:
         return None, None, "the scene has no tangential direction (frictionless)"
-    tangential = np.linalg.norm(outcome.Pt.reshape(problem.m, problem.d), axis=1)
-    excess = tangential - problem.mu * outcome.Pn
-    value = float(excess.max()) / _scale(np.concatenate([outcome.Pn, outcome.Pt]))
+    # In units of the largest impulse, where the norms of impulses near 1e308 do not overflow;
+    # a contact deep inside a wide cone (mu = 1e300) counts as an excess of -1 at most.
+    scale = _scale(np.concatenate([outcome.Pn, outcome.Pt]))
+    tangential = np.linalg.norm(outcome.Pt.reshape(problem.m, problem.d) / scale, axis=1)
+    with np.errstate(over="ignore"):
+        excess = np.maximum(tangential - problem.mu * (outcome.Pn / scale), -1.0)
+    value = float(excess.max())
     if value <= TOLERANCE:
         return value, True, "every tangential impulse lies in its friction cone"
     j = int(np.argmax(excess))
-    bound = problem.mu[j] * outcome.Pn[j]
-    return value, False, f"contact {j}: |Pt| = {tangential[j]:.6g} exceeds mu Pn = {bound:.6g}"
+    return (
+        value,
+        False,
+        (
+            f"contact {j}: |Pt| = {tangential[j] * scale:.6g} exceeds mu Pn = "
+            f"{problem.mu[j] * outcome.Pn[j]:.6g}"
+        ),
+    )
 
 
 # Coordinates up to which the momentum check finds a problem's free directions by a dense SVD

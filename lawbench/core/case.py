@@ -147,11 +147,17 @@ class Case(ABC):
             message names the parameters given).
         """
         params = self.parameters(**given)
+        defaults = self.parameters()
+        changed = {k: v for k, v in given.items() if not np.array_equal(v, defaults.get(k))}
+        named = ", ".join(f"{k} = {v!r}" for k, v in changed.items()) or "the defaults"
         try:
             return self._build(params)
         except (OverflowError, FloatingPointError) as exc:
-            named = ", ".join(f"{k} = {v!r}" for k, v in given.items()) or "the defaults"
             raise InvalidProblem(f"{self.name}: {named}: the geometry overflows ({exc})") from None
+        except InvalidProblem as exc:
+            # The scene's formulas at these parameters left double precision, or gave a
+            # problem no law can take: the message names what the user gave.
+            raise InvalidProblem(f"{self.name}: {named}: {exc}") from None
 
     def _check(self, params: dict[str, Any]) -> None:
         """Check relations between parameters (list lengths); raise `InvalidProblem`."""

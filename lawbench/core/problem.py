@@ -266,11 +266,16 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     return _read_only_finite(name, array)
 
 
+def _non_finite(value: float) -> str:
+    """What a non-finite number is, in words (a message never shows a NaN of its own)."""
+    return "is not a number" if math.isnan(value) else f"is {'-' if value < 0 else ''}infinite"
+
+
 def _read_only_finite(name: str, array: np.ndarray) -> np.ndarray:
     """Make ``array`` (the problem's own copy) read-only, or raise naming a non-finite entry."""
     if not all_finite(array):
         index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
-        raise InvalidProblem(f"{name}{list(index)} = {array[index]}: must be finite")
+        raise InvalidProblem(f"{name}{list(index)} {_non_finite(array[index])}: must be finite")
     array.setflags(write=False)
     return array
 
@@ -294,7 +299,8 @@ def _sparse_matrix(name: str, value: object, shape: tuple[int, int]) -> Any:
         k = int(bad[0])
         column = int(np.searchsorted(matrix.indptr, k, side="right")) - 1
         raise InvalidProblem(
-            f"{name}{[int(matrix.indices[k]), column]} = {matrix.data[k]}: must be finite"
+            f"{name}{[int(matrix.indices[k]), column]} {_non_finite(matrix.data[k])}: must be "
+            "finite"
         )
     matrix.eliminate_zeros()
     for part in (matrix.data, matrix.indices, matrix.indptr):

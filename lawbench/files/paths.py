@@ -33,6 +33,8 @@ def _kind(mode: int) -> str:
 def _path(path: object, what: str) -> Path:
     if not isinstance(path, str | os.PathLike):
         raise TypeError(f"{what}: a path (str or os.PathLike), not {type(path).__name__}")
+    if "\x00" in os.fspath(path):
+        raise InvalidProblem(f"{what} {os.fspath(path)!r}: a path cannot hold a NUL character")
     return Path(path)
 
 
@@ -79,4 +81,33 @@ def output_file(path: str | Path, what: str = "output") -> Path:
         raise InvalidProblem(f"{what} {path}: cannot be written ({exc.strerror or exc})") from None
     if not stat.S_ISREG(mode):
         raise InvalidProblem(f"{what} {path}: {_kind(mode)}, not a regular file")
+    return path
+
+
+def output_folder(path: str | Path, what: str = "output folder") -> Path:
+    """``path`` as a `Path` once it is known to be a directory or one that can be made.
+
+    Raises
+    ------
+    InvalidProblem
+        Naming ``what`` and the path, for an existing path that is not a directory, or one
+        below a path that is not.
+    TypeError
+        For a ``path`` that is not a path.
+    """
+    path = _path(path, what)
+    for ancestor in (path, *path.parents):
+        try:
+            mode = ancestor.stat().st_mode
+        except FileNotFoundError:
+            continue
+        except OSError as exc:
+            raise InvalidProblem(
+                f"{what} {path}: cannot be written ({exc.strerror or exc})"
+            ) from None
+        if not stat.S_ISDIR(mode):
+            kind = "a regular file" if stat.S_ISREG(mode) else _kind(mode)
+            where = "" if ancestor == path else f"{ancestor} is "
+            raise InvalidProblem(f"{what} {path}: {where}{kind}, not a directory")
+        return path
     return path

@@ -43,7 +43,7 @@ from lawbench.core.errors import InvalidProblem
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import Contact, ImpactProblem, is_sparse
 from lawbench.files.hdf5 import require_h5py
-from lawbench.files.paths import input_file, output_file
+from lawbench.files.paths import MAX_BYTES, input_file, output_file
 
 FORMAT, VERSION = "lawbench-problem", 1
 MATRICES = ("M", "Wn", "Wt", "v", "gaps")
@@ -202,6 +202,14 @@ def _json_default(value: Any) -> Any:
 
 
 def _write_json(data: dict[str, Any], path: Path) -> None:
+    # JSON holds matrices dense, each entry at least two characters ("0,"): a file that no
+    # reader takes (more than MAX_BYTES) is refused before its dense copy is made.
+    entries = sum(int(np.prod(value.shape)) for value in data.values() if is_sparse(value))
+    if 2 * entries > MAX_BYTES:
+        raise InvalidProblem(
+            f"{path}: JSON holds matrices dense, {entries:.3g} entries here, more than a problem "
+            f"file may hold ({MAX_BYTES} bytes); write .npz or .h5, which keep them sparse"
+        )
     path.write_text(json.dumps(data, default=_json_default, indent=1, allow_nan=False) + "\n")
 
 

@@ -15,6 +15,7 @@ its default value), the same in a study's table and on the command line
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -48,14 +49,19 @@ class Transform:
 
 def grazing(problem: ImpactProblem, speed: float) -> ImpactProblem:
     """``problem`` with its gap rates scaled so that the fastest approach is ``speed``."""
-    if speed <= 0:
-        raise InvalidProblem(f"grazing speed {speed:g}: must be positive")
+    if not 0 < speed < math.inf:
+        raise InvalidProblem(f"grazing speed {speed:g}: must be positive and finite")
     un = problem.un
     fastest = float(-un.min())
     if fastest <= 0:
         raise InvalidProblem("grazing: no contact approaches, nothing to make grazing")
     change, *_ = np.linalg.lstsq(problem.delassus, (speed / fastest - 1.0) * un, rcond=None)
-    return dataclasses.replace(problem, v=problem.v + problem.solve_mass(problem.Wn @ change))
+    try:
+        return dataclasses.replace(problem, v=problem.v + problem.solve_mass(problem.Wn @ change))
+    except InvalidProblem as exc:
+        raise InvalidProblem(
+            f"grazing={speed:g}: the velocity leaves double precision ({exc})"
+        ) from None
 
 
 def duplicated(problem: ImpactProblem, contact: float = 0) -> ImpactProblem:

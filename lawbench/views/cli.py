@@ -32,7 +32,7 @@ from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.registry import Registry
 from lawbench.core.trial import evaluate
-from lawbench.files.paths import output_file
+from lawbench.files.paths import output_file, output_folder
 from lawbench.numerics.transforms import apply
 from lawbench.studies.guard import BUDGET_S, EXECUTORS, alarm
 from lawbench.views.serialize import trial_record
@@ -166,14 +166,23 @@ def _law_object(text: str) -> Law:
     import importlib
 
     module, _, attribute = text.partition(":")
+    if not (module and attribute):
+        raise InvalidProblem(f"{text!r}: name a law as MODULE:ATTRIBUTE, both non-empty")
     try:
         loaded = getattr(importlib.import_module(module), attribute)
-    except (ImportError, AttributeError) as exc:
+    except (ImportError, AttributeError, TypeError) as exc:
+        # TypeError: a relative module name ('..x'), which has no package to start from.
         raise InvalidProblem(f"{text}: cannot be imported ({exc})") from None
-    law = loaded() if isinstance(loaded, type) else loaded
-    if not isinstance(law, Law):
+    if isinstance(loaded, type):
+        if not issubclass(loaded, Law):
+            raise InvalidProblem(f"{text} is not a lawbench.Law")
+        try:
+            loaded = loaded()
+        except TypeError as exc:  # an abstract class, or one whose constructor takes arguments
+            raise InvalidProblem(f"{text}: cannot be made a law ({exc})") from None
+    if not isinstance(loaded, Law):
         raise InvalidProblem(f"{text} is not a lawbench.Law")
-    return law
+    return loaded
 
 
 def _check(args: argparse.Namespace) -> None:
@@ -334,7 +343,7 @@ def _solve(args: argparse.Namespace) -> None:
 def _report(args: argparse.Namespace) -> None:
     from lawbench.views.report import write_report
 
-    path = write_report(Path(args.out), mode=args.mode)
+    path = write_report(output_folder(args.out, "report folder"), mode=args.mode)
     print(f"report written to {path}")
 
 
@@ -826,7 +835,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             if args.verbose or issubclass(warning.category, LossyExport):
                 print(f"lawbench: warning: {warning.message}", file=sys.stderr)
     except LawbenchError as exc:
-        print(f"lawbench: {exc}", file=sys.stderr)
+        print(f"lawbench: {_one_line(exc)}", file=sys.stderr)
         return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
     except BrokenPipeError:
         return 0
@@ -836,6 +845,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         return 130
     except Exception as exc:  # a bug: still one line, never a traceback
-        print(f"lawbench: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        print(f"lawbench: internal error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
         return 1
     return 0
+
+
+def _one_line(message: object) -> str:
+    """``message`` on one line: a library's message or a path may hold line breaks."""
+    return " ".join(line.strip() for line in str(message).splitlines() if line.strip())
