@@ -108,6 +108,18 @@ def test_run_checks_on_a_problem_of_your_own():
         (lambda: lawbench.plot_outcome(None), "outcome must be an Outcome or a Trial"),
         (lambda: lawbench.plot_path("x"), "outcome must be an Outcome or a Trial"),
         (lambda: lawbench.plot_sweep("table", "x", "y"), "frame must be a pandas DataFrame"),
+        (lambda: lawbench.save_problem(None, "p.json"), "problem must be an ImpactProblem"),
+        (lambda: lawbench.check_law("newton", random_problems=1.5), "random_problems must be"),
+        (
+            lambda: lawbench.ImpactProblem.from_arrays(
+                np.eye(2), [[-1.0], [1.0]], [1, 0], bodies=1
+            ),
+            "bodies must be a mapping",
+        ),
+        (
+            lambda: lawbench.plot_outcome(lawbench.solve("newton", "three_ball_chain"), ax="x"),
+            "ax must be matplotlib Axes",
+        ),
     ],
 )
 def test_a_wrong_argument_is_a_type_error_that_names_it(call, named):
@@ -130,3 +142,33 @@ def test_a_problem_with_a_vector_that_is_not_numeric_is_invalid_naming_it():
         lawbench.ProblemBatch(np.eye(2), np.array([[-1.0], [1.0]]), "x", {})
     with pytest.raises(lawbench.InvalidProblem, match=r"coefficients\['e'\]: not an array"):
         lawbench.ProblemBatch(np.eye(2), np.array([[-1.0], [1.0]]), [[1.0, 0.0]], {"e": "a"})
+
+
+@pytest.mark.parametrize(
+    ("call", "named"),
+    [
+        (lambda: lawbench.solve("newton", "three_ball_chain", e=10**400), r"e\[0\] = 1000"),
+        (lambda: lawbench.solve("newton", "three_ball_chain", masses=b"abc"), "masses"),
+        (lambda: lawbench.Verdict("nope"), "verdict 'nope': must be one of holds"),
+        (lambda: lawbench.load_problem("a\x00b.json"), "cannot hold a NUL"),
+        (lambda: lawbench.check_law("newton", random_problems=-1), "random_problems = -1"),
+        (
+            lambda: lawbench.ImpactProblem.from_arrays(np.eye(2) * 1j, [[-1.0], [1.0]], [1, 0]),
+            "M: complex numbers",
+        ),
+        (
+            lambda: lawbench.ImpactProblem.from_arrays(np.eye(2), [[-1.0, 0.0], [1.0]], [1, 0]),
+            "Wn: not an array of numbers",
+        ),
+        (
+            lambda: lawbench.ImpactProblem.from_arrays(
+                np.eye(2), [[-1.0], [1.0]], [1, 0], bodies={"a": "xyz"}
+            ),
+            r"bodies\['a'\] = 'xyz': not indices",
+        ),
+    ],
+)
+def test_a_bad_value_is_invalid_naming_it(call, named):
+    """Never a bare ValueError, OverflowError or a silent conversion: the argument is named."""
+    with pytest.raises(lawbench.InvalidProblem, match=named):
+        call()

@@ -257,6 +257,8 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`."""
     if is_sparse(value):
         value = value.toarray()
+    if np.iscomplexobj(value):
+        raise InvalidProblem(f"{name}: complex numbers; a problem holds real ones")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -464,8 +466,15 @@ class ImpactProblem:
                 raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
         state["gaps"] = gaps
         checked: dict[str, tuple[int, ...]] = {}
+        if bodies is not None and not isinstance(bodies, Mapping):
+            raise TypeError(
+                f"bodies must be a mapping of names to indices, not {type(bodies).__name__}"
+            )
         for name, indices in (bodies or {}).items():
-            idx = tuple(int(i) for i in indices)
+            try:
+                idx = tuple(int(i) for i in indices)
+            except (TypeError, ValueError):
+                raise InvalidProblem(f"bodies[{str(name)!r}] = {indices!r}: not indices") from None
             if any(i < 0 or i >= n for i in idx):
                 raise InvalidProblem(f"bodies[{str(name)!r}] = {idx}: indices must lie in [0, {n})")
             checked[str(name)] = idx
@@ -503,7 +512,10 @@ class ImpactProblem:
         InvalidProblem
             For an unknown coefficient, a sequence of the wrong length, or any bad field.
         """
-        shape = Wn.shape if type(Wn) is np.ndarray else np.shape(Wn)
+        try:
+            shape = Wn.shape if type(Wn) is np.ndarray else np.shape(Wn)
+        except ValueError as exc:  # a ragged nesting of lists
+            raise InvalidProblem(f"Wn: not an array of numbers ({exc})") from None
         m = shape[1] if len(shape) == 2 else 0
         shared: dict[str, object] = {}
         per_contact: dict[str, list[object]] = {}

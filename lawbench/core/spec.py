@@ -79,7 +79,7 @@ class Spec:
         """
         if self.kind == "floats":
             items = value.split(",") if isinstance(value, str) else value
-            if not isinstance(items, Sequence) or isinstance(items, str):
+            if not isinstance(items, Sequence) or isinstance(items, str | bytes):
                 items = [items]
             if len(items) == 0:
                 raise InvalidProblem(f"{self.name} is empty: give at least one number")
@@ -108,7 +108,8 @@ class Spec:
     def _number(self, label: str, value: Any, kind: type) -> float | int:
         try:
             number = float(value.strip() if isinstance(value, str) else value)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
+            # OverflowError: an integer beyond the largest double (10**400).
             raise InvalidProblem(f"{label} = {value!r}: not a number") from None
         if isinstance(value, bool):
             raise InvalidProblem(f"{label} = {value!r}: not a number")

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
-from lawbench.core.errors import BudgetExceeded, NotApplicable, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 
 
 class Verdict(StrEnum):
@@ -37,6 +37,12 @@ class Verdict(StrEnum):
     REFUSED = "refused"
     BUDGET = "budget"
     UNEXPLAINED = "unexplained"
+
+    @classmethod
+    def _missing_(cls, value: object) -> Verdict:
+        raise InvalidProblem(
+            f"verdict {value!r}: must be one of {', '.join(verdict.value for verdict in cls)}"
+        )
 
 
 # Classes a finished, trustworthy table may hold.

@@ -128,6 +128,8 @@ def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
     InvalidProblem
         For an unknown extension, or a file that cannot be written.
     """
+    if not isinstance(problem, ImpactProblem):
+        raise TypeError(f"problem must be an ImpactProblem, not {type(problem).__name__}")
     path = output_file(path, "problem file")
     writer = _codec(path)[0]
     try:

@@ -31,6 +31,8 @@ if TYPE_CHECKING:
 
 SEVERAL_SOLVES = tuple(name for name in CHECKS if name not in SINGLE_SOLVE)
 COLUMNS = ("law", "scene", "example", "check", "verdict", "value", "detail", "claim")
+# Seeded random problems a check of a law adds at most.
+MAX_RANDOM = 100_000
 
 
 @dataclass(frozen=True)
@@ -211,6 +213,10 @@ def check_law(
         declaration is unsound.
     """
     law = LAWS.get(law)
+    if isinstance(random_problems, bool) or not isinstance(random_problems, int):
+        raise TypeError(f"random_problems must be an int, not {type(random_problems).__name__}")
+    if not 0 <= random_problems <= MAX_RANDOM:
+        raise InvalidProblem(f"random_problems = {random_problems}: must lie in [0, {MAX_RANDOM}]")
     for name in cases or ():
         CASES.get(name)  # an unknown scene is an error, never an empty table that passes
     rows = [run_cell(law, cell, continuity_sizes) for cell in cells(law, cases, random_problems)]

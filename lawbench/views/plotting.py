@@ -40,8 +40,12 @@ COMPONENT = re.compile(r"^(.+)\[(\d+)\]$")
 
 def _axes(ax: Axes | None) -> Axes:
     """``ax``, or the axes of a new pyplot figure."""
-    if ax is not None:
+    from matplotlib.axes import Axes
+
+    if isinstance(ax, Axes):
         return ax
+    if ax is not None:
+        raise TypeError(f"ax must be matplotlib Axes or None, not {type(ax).__name__}")
     import matplotlib.pyplot as plt
 
     return plt.figure().add_subplot()
