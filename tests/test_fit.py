@@ -1,5 +1,8 @@
 """Identifying coefficients from measured velocities: `lawbench.fit` and ``lawbench fit``."""
 
+import json
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -159,3 +162,145 @@ def test_cli_bad_csv_exits_2_with_one_line(tmp_path, capsys):
     assert code == 2
     assert err.count("\n") == 1 and "row 1, column 'v2_plus'" in err
     assert "Traceback" not in err
+
+
+def _cli(capsys, *args):
+    """Exit code, stdout and stderr of ``lawbench fit newton two_balls_wall ...``."""
+    code = main(["fit", "newton", "two_balls_wall", *args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def measured(tmp_path):
+    """Three noise-free trials of Newton's law at e = 0.5, in a CSV file."""
+    path = tmp_path / "trials.csv"
+    _trials("newton", "two_balls_wall", _approaches(3, 8), e=[0.5]).to_csv(path, index=False)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("free", "message"),
+    [
+        ("e[5]", r"'e\[5\]': e has 2 entries at these parameters \(e\[0\] to e\[1\]\)"),
+        ("masses[9]", r"'masses\[9\]': masses has 2 entries"),
+    ],
+)
+def test_an_entry_past_the_end_of_a_list_is_refused_with_its_length(free, message):
+    data = _trials("newton", "two_balls_wall", _approaches(3, 8), e=[0.5])
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        lawbench.fit("newton", "two_balls_wall", data, free=[free])
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        ("x", "start e = 'x': not a number"),
+        (float("nan"), "start e = nan: must be a finite number"),
+        (True, "start e = True: not a number"),
+        (1.5, r"start e = 1.5: must lie in \[0, 1\]"),
+    ],
+)
+def test_a_starting_value_is_a_finite_number_in_the_parameter_s_range(value, message):
+    data = _trials("newton", "two_balls_wall", _approaches(3, 8), e=[0.5])
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        lawbench.fit("newton", "two_balls_wall", data, free=["e"], start={"e": value})
+
+
+@pytest.mark.parametrize(
+    ("argument", "value", "message"),
+    [
+        ("noise", 1e308, r"noise = 1e\+308: must lie in \[1e-12, 1e\+06\]"),
+        ("noise", 0.0, "noise = 0: must lie in"),
+        ("seed", -1, r"seed = -1: must lie in \[0, inf\)"),
+        ("tol", 0, r"tol = 0: must lie in \[1e-15, 0.1\]"),
+        ("tol", -1.0, "tol = -1: must lie in"),
+        ("tol", float("nan"), "tol = nan: must lie in"),
+        ("holdout", 1.0, r"holdout = 1: must lie in \[0, 1\)"),
+        ("bootstrap", -1, "bootstrap = -1: must lie in"),
+        ("diff_step", 0.0, "diff_step = 0: must lie in"),
+        ("flat_tol", -1.0, "flat_tol = -1: must lie in"),
+    ],
+)
+def test_a_number_outside_its_range_is_refused_before_any_solve(argument, value, message):
+    data = _trials("newton", "two_balls_wall", _approaches(3, 8), e=[0.5])
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        lawbench.fit("newton", "two_balls_wall", data, free=["e"], **{argument: value})
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"free": [1]}, r"free\[0\] must be a coefficient name \(str\), not int"),
+        ({"free": 3}, "free must be a coefficient name or a sequence of them, not int"),
+        ({"free": ["e"], "params": "x"}, "params must be a mapping of names to values, not str"),
+        ({"free": ["e"], "options": 1}, "options must be a mapping"),
+        ({"free": ["e"], "start": "x"}, "start must be a mapping"),
+        ({"free": ["e"], "seed": 1.5}, "seed must be an integer, not float"),
+        ({"free": ["e"], "seed": True}, "seed must be an integer, not bool"),
+        ({"free": ["e"], "holdout": "x"}, "holdout must be a real number, not str"),
+    ],
+)
+def test_an_argument_of_the_wrong_type_is_a_type_error_naming_it(arguments, message):
+    data = _trials("newton", "two_balls_wall", _approaches(3, 8), e=[0.5])
+    with pytest.raises(TypeError, match=message):
+        lawbench.fit("newton", "two_balls_wall", data, **arguments)
+
+
+def test_one_name_stands_for_a_list_of_one():
+    data = _trials("newton", "two_balls_wall", _approaches(3, 8), e=[1.0, 0.5])
+    result = lawbench.fit("newton", "two_balls_wall", data, free="e[1]")
+    assert result.values["e[1]"] == pytest.approx(0.5, abs=1e-8)
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--free", "e[99]"],
+        ["--free", "e", "--start", "e=nan"],
+        ["--free", "e", "--start", "e=x"],
+        ["--free", "e", "--noise", "1e308"],
+    ],
+)
+def test_cli_bad_coefficient_start_or_noise_exits_2_with_one_line(capsys, measured, args):
+    code, _, err = _cli(capsys, "--data", str(measured), *args)
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("lawbench: ") and "internal" not in err
+
+
+@pytest.mark.parametrize(
+    "content",
+    [
+        b"v1_minus,v2_minus,v1_plus,v2_plus\n1,2\n1,2,3,4,5,6\n",
+        bytes(range(256)) * 4,
+    ],
+    ids=["ragged", "binary"],
+)
+def test_csv_that_cannot_be_parsed_is_refused_in_one_line(tmp_path, content):
+    path = tmp_path / "measured.csv"
+    path.write_bytes(content)
+    with pytest.raises(lawbench.InvalidProblem, match=r"measured\.csv': cannot be read") as caught:
+        lawbench.fit("newton", "two_balls_wall", path, free=["e"])
+    assert "\n" not in str(caught.value)
+
+
+def test_a_coefficient_the_law_does_not_read_is_named_and_prints_no_nan(capsys, measured):
+    """Newton's law ignores the stiffness ratio: its correlations are undefined, printed '-'."""
+    code, out, _ = _cli(capsys, "--data", str(measured), "--free", "e,stiffness_ratio")
+    assert code == 0
+    assert "nan" not in out.lower()
+    assert "not read by newton (its answer does not change with them): stiffness_ratio" in out
+    assert re.search(r"stiffness_ratio +- +-\n", out)
+    code, out, _ = _cli(capsys, "--data", str(measured), "--free", "e,stiffness_ratio", "--json")
+    (result,) = json.loads(out)
+    assert result["unread"] == ["stiffness_ratio"]
+    assert result["correlations"] == [[1.0, None], [None, None]]
+
+
+def test_no_degree_of_freedom_left_prints_no_nan(capsys, measured):
+    """Two coefficients fitted on one trial of two velocities, one bootstrap draw."""
+    args = ["--free", "e[0],e[1]", "--holdout", "0.5", "--bootstrap", "1"]
+    code, out, _ = _cli(capsys, "--data", str(measured), *args)
+    assert code == 0
+    assert "nan" not in out.lower()
+    assert "estimated noise sigma undefined" in out

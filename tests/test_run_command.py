@@ -122,6 +122,38 @@ def test_bad_specs_stop_with_one_line(tmp_path, args, message):
     assert not list(tmp_path.glob("results*"))
 
 
+GRID = '[[grid]]\nlaws = ["newton"]\ncases = ["three_ball_chain"]\nparams = {{ {} }}\n'
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ("masses = { random = [2.0, 0.5, 2], size = 3 }", "low 2 is above high 0.5"),
+        ("masses = { random = [0.5, inf, 2] }", "bounds 0.5 and inf must be finite"),
+        ("masses = { random = [0.5, 2.0, 2], size = 1000000000000 }", "a size of 1000000000000"),
+        ("e = { range = [0, 1, 1e21] }", "a count of 1000000000000000000000"),
+        (
+            "e = { range = [0, 1, 1001] }, masses = { range = [1, 2, 1000000] }",
+            "a grid of 1001000000 cells, more than the 1000000000",
+        ),
+    ],
+)
+def test_a_bad_generator_or_a_grid_too_large_stops_with_one_line(tmp_path, params, message):
+    (tmp_path / "grid.toml").write_text(GRID.format(params))
+    result = lawbench("run", "grid.toml", "--executor", "serial", cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert len(result.stderr.splitlines()) == 1 and re.search(message, result.stderr)
+    assert not list(tmp_path.glob("results*"))
+
+
+def test_a_param_nested_deep_stops_with_one_short_line(tmp_path):
+    nested = "e=" + "[" * 50_000 + "]" * 50_000
+    result = lawbench("run", "--cases", "three_ball_chain", "--param", nested, cwd=tmp_path)
+    assert result.returncode == 2
+    assert len(result.stderr.splitlines()) == 1 and "nested brackets" in result.stderr
+    assert len(result.stderr) < 300
+
+
 # The optional dependencies (extras dask and hdf5; cvxpy and hypothesis come with the tests):
 # blocked, as in an installation without extras.
 WITHOUT_EXTRAS = """

@@ -14,6 +14,7 @@ import lawbench
 from lawbench.checks.study import Job, Plan
 from lawbench.studies.runfile import Store
 from lawbench.studies.runner import Task, compute, run
+from lawbench.views.cli import main
 
 GRID = [
     "--laws",
@@ -147,3 +148,29 @@ def test_an_output_format_that_is_not_clear_exits_2(tmp_path, args, message):
     assert result.returncode == 2
     assert message in result.stderr and len(result.stderr.splitlines()) == 1
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("name", "write", "message"),
+    [
+        ("junk.parquet", lambda path: path.write_text("not a table"), "not a table a run wrote"),
+        (
+            "other.parquet",
+            lambda path: pd.DataFrame({"a": [1, 2]}).to_parquet(path),
+            "a table no run wrote",
+        ),
+        ("other.csv", lambda path: path.write_text("a\n1\n"), "a table no run wrote"),
+    ],
+)
+def test_an_output_that_is_not_a_run_table_is_refused_naming_it(
+    tmp_path, capsys, name, write, message
+):
+    out = tmp_path / name
+    write(out)
+    before = out.read_bytes()
+    args = ["run", "--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial"]
+    code = main([*args, "--quiet", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and f"{name}: {message}" in err
+    assert out.read_bytes() == before

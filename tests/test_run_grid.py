@@ -2,6 +2,8 @@
 
 import io
 import json
+import math
+import os
 import re
 import subprocess
 import sys
@@ -226,6 +228,52 @@ def test_a_bad_run_file_names_the_key(spec, message):
         RunSpec.from_dict(spec).rows()
 
 
+ONE_GRID = {"laws": ["newton"], "cases": ["three_ball_chain"]}
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ({"masses": {"random": [2.0, 0.5, 2], "size": 3}}, "low 2 is above high 0.5"),
+        ({"masses": {"random": [0.5, math.inf, 2]}}, "its bounds 0.5 and inf must be finite"),
+        ({"e": {"range": [0, math.nan, 3]}}, "its bounds 0 and nan must be finite"),
+        (
+            {"masses": {"random": [0.0, 2.0, 2], "log": True}},
+            "log = true draws between positive bounds, not from 0",
+        ),
+        ({"masses": {"random": [-1e308, 1e308, 2]}}, "span -1e\\+308 to 1e\\+308 exceeds"),
+        ({"masses": {"random": [0.5, 2.0, 2], "size": 10**12}}, "a size of 1000000000000, outside"),
+        ({"e": {"range": [0, 1, 10**21]}}, "a count of 1000000000000000000000, outside 0..1000"),
+        ({"e": {"range": [0, 1, math.inf]}}, "cannot convert float infinity"),
+    ],
+)
+def test_a_bad_generator_is_refused_when_the_grid_is_read(params, message):
+    with pytest.raises(lawbench.InvalidProblem, match=f"grid\\[0\\].params.*{message}"):
+        RunSpec.from_dict({"grid": [{**ONE_GRID, "params": params}]})
+
+
+@pytest.mark.parametrize("count", [10**6, 10**9])
+def test_a_grid_above_the_largest_is_refused_with_its_count(count):
+    axes = {name: {"range": [0.5, 1, count]} for name in ("e", "masses", "velocities")}
+    spec = RunSpec.from_dict({"grid": [{**ONE_GRID, "params": axes}]})
+    with pytest.raises(lawbench.InvalidProblem, match=f"a grid of {count**3} cells, more than"):
+        spec.count()
+
+
+@pytest.mark.parametrize("text", ["[[0.5]]", "[1,[2]]", "[" * 100_000 + "]" * 100_000])
+def test_nested_brackets_are_refused_in_one_short_line(text):
+    with pytest.raises(lawbench.InvalidProblem, match="nested brackets") as caught:
+        parse_values("e", text)
+    assert len(str(caught.value)) < 200
+
+
+def test_braces_nested_deep_are_a_word_or_a_malformed_vector():
+    deep = '{"a":' * 100_000 + "1" + "}" * 100_000
+    assert parse_values("e", deep) == [deep]
+    with pytest.raises(lawbench.InvalidProblem, match="malformed vector"):
+        parse_values("e", f"[{deep}]")
+
+
 def test_the_run_file_of_the_readme_is_valid():
     readme = (Path(__file__).parents[1] / "README.md").read_text()
     text = readme.split("```toml\n", 1)[1].split("```", 1)[0]
@@ -267,8 +315,24 @@ def test_csv_expands_vectors_and_load_run_gathers_them(three):
 
 
 def test_load_run_of_a_missing_file_is_invalid(tmp_path):
-    with pytest.raises(lawbench.InvalidProblem, match="does not exist"):
+    with pytest.raises(lawbench.InvalidProblem, match=r"none\.parquet: cannot be read"):
         lawbench.load_run(tmp_path / "none.parquet")
+
+
+def test_load_run_of_a_file_no_run_wrote_names_it(tmp_path):
+    (tmp_path / "junk.parquet").write_text("not a table")
+    with pytest.raises(lawbench.InvalidProblem, match=r"junk\.parquet: not a table a run wrote"):
+        lawbench.load_run(tmp_path / "junk.parquet")
+    (tmp_path / "junk.csv").write_text("a\n")
+    (tmp_path / "junk.csv.meta.json").write_text("{")
+    with pytest.raises(lawbench.InvalidProblem, match=r"junk\.csv\.meta\.json: not JSON"):
+        lawbench.load_run(tmp_path / "junk.csv")
+
+
+def test_load_run_of_a_fifo_is_refused_before_it_is_opened(tmp_path):
+    os.mkfifo(tmp_path / "fifo.parquet")
+    with pytest.raises(lawbench.InvalidProblem, match=r"fifo\.parquet: a FIFO, not a regular file"):
+        lawbench.load_run(tmp_path / "fifo.parquet")
 
 
 # Progress.

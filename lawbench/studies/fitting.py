@@ -20,7 +20,9 @@ noise variance is estimated as ``s^2 = RSS / (N - p)`` (N residuals, p coefficie
 covariance is ``s^2 (J^T J)^-1``, mapped to the parameters' own scale by the delta method. A
 singular value of J below ``flat_tol`` times the largest is a flat direction: the coefficients
 that carry it are reported as not identifiable from the data (infinite standard error), and the
-covariance of the others is taken on the orthogonal complement. With ``noise`` (the standard
+covariance of the others is taken on the orthogonal complement; a coefficient the law's answer
+does not change with (a zero column of J: the law does not read it) is named as such, and its
+correlations are undefined, printed as ``-`` and written as null. With ``noise`` (the standard
 deviation of a measured velocity) the residual is also judged: a sum of squares above the
 99.9% quantile of ``noise^2 chi^2(N - p)`` says the law cannot fit the data. ``bootstrap``
 refits on trials resampled with replacement; ``holdout`` keeps a fraction of the trials out of
@@ -33,6 +35,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -59,6 +62,54 @@ CHI2_QUANTILE = 0.999
 _ITEM = re.compile(r"^(?P<name>[A-Za-z_]\w*)(\[(?P<index>\d+)\])?$")
 
 
+@dataclass(frozen=True)
+class _Range:
+    """The values a numeric argument of `fit` may take: a real or an integer in an interval."""
+
+    low: float
+    high: float
+    whole: bool = False
+    high_open: bool = False
+
+    def check(self, name: str, value: object) -> None:
+        """Refuse ``value`` of argument ``name`` unless it is a number in this range.
+
+        Raises
+        ------
+        TypeError
+            For a value that is not a number (a bool is not), or not an integer where one is due.
+        InvalidProblem
+            For a value outside the range, naming the argument, the value and the range.
+        """
+        kind = numbers.Integral if self.whole else numbers.Real
+        if not isinstance(value, kind) or isinstance(value, bool):
+            wanted = "an integer" if self.whole else "a real number"
+            raise TypeError(f"{name} must be {wanted}, not {type(value).__name__}")
+        number = int(value) if self.whole else float(value)
+        below_high = number < self.high if self.high_open else number <= self.high
+        if not (self.low <= number and below_high):  # NaN fails both comparisons
+            shown = f"{number}" if self.whole else f"{number:g}"
+            raise InvalidProblem(f"{name} = {shown}: must lie in {self}")
+
+    def __str__(self) -> str:
+        closing = ")" if self.high_open or math.isinf(self.high) else "]"
+        return f"[{self.low:g}, {self.high:g}{closing}"
+
+
+# The ranges of fit's numeric arguments. The noise is the standard deviation of a measured
+# velocity: below 1e-12 m/s no measurement resolves a velocity, above 1e6 m/s it measures
+# nothing; scipy's tolerances must exceed the machine epsilon.
+RANGES = {
+    "noise": _Range(1e-12, 1e6),
+    "holdout": _Range(0.0, 1.0, high_open=True),
+    "bootstrap": _Range(0, 100_000, whole=True),
+    "seed": _Range(0, math.inf, whole=True),
+    "tol": _Range(1e-15, 0.1),
+    "diff_step": _Range(1e-12, 0.1),
+    "flat_tol": _Range(0.0, 0.5),
+}
+
+
 def coordinate_key(name: str) -> str:
     """A coordinate's name without its unit: ``'v1 [m/s]'`` -> ``'v1'``."""
     return name.split(" [")[0].strip()
@@ -79,8 +130,8 @@ def read_trials(
     Raises
     ------
     InvalidProblem
-        A missing column, or a value that is not a finite number, naming its row (1 is the
-        first trial) and column.
+        A file that cannot be read as CSV (the reason in one line), a missing column, or a
+        value that is not a finite number, naming its row (1 is the first trial) and column.
     """
     if isinstance(data, pd.DataFrame):
         frame = data.astype(str)
@@ -95,7 +146,8 @@ def read_trials(
             pd.errors.ParserError,
             pd.errors.EmptyDataError,
         ) as exc:
-            raise InvalidProblem(f"data {str(data)!r}: cannot be read ({exc})") from None
+            reason = " ".join(str(exc).split())  # the parser's message may span lines
+            raise InvalidProblem(f"data {str(data)!r}: cannot be read ({reason})") from None
     frame.columns = [str(c).strip() for c in frame.columns]
     minus, plus = columns(case, params)
     missing = [c for c in minus + plus if c not in frame.columns]
@@ -127,11 +179,27 @@ class _Free:
     """One fitted coefficient: where it sits in the parameters and how it is scaled."""
 
     label: str
-    name: str
+    spec: Spec
     index: int | None
     low: float
     high: float
     log: bool
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    def checked(self, value: object) -> float:
+        """A starting value given for this coefficient, checked against its parameter's range.
+
+        Raises
+        ------
+        InvalidProblem
+            Naming ``start`` and the coefficient, for a value that is not a finite number in
+            the parameter's range.
+        """
+        alone = dataclasses.replace(self.spec, name=f"start {self.label}", kind="float")
+        return alone.coerce(value)
 
     def to_x(self, value: float) -> float:
         return math.log(value) if self.log else value
@@ -145,11 +213,45 @@ class _Free:
         return self.low, self.high
 
 
-def _free_coefficients(scene: Case, free: Sequence[str]) -> list[_Free]:
+def _labels(free: object) -> list[str]:
+    """The argument ``free`` as a list of names: one name, or a sequence of names.
+
+    Raises
+    ------
+    TypeError
+        For anything else, naming ``free`` (or the entry ``free[k]`` that is not a name).
+    """
+    names = [free] if isinstance(free, str) else free
+    if not isinstance(names, Sequence):
+        raise TypeError(
+            f"free must be a coefficient name or a sequence of them, not {type(free).__name__}"
+        )
+    for k, name in enumerate(names):
+        if not isinstance(name, str):
+            raise TypeError(
+                f"free[{k}] must be a coefficient name (str), not {type(name).__name__}"
+            )
+    return [name.strip() for name in names]
+
+
+def _mapping(name: str, value: object) -> dict[str, Any]:
+    """The argument ``name`` as a dict: a mapping of names to values, or None for none."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise TypeError(f"{name} must be a mapping of names to values, not {type(value).__name__}")
+    return dict(value)
+
+
+def _free_coefficients(scene: Case, free: list[str], fixed: dict[str, Any]) -> list[_Free]:
+    """The coefficients named in ``free``.
+
+    Each is a numeric parameter of ``scene``, or an entry of a list parameter that has it at the
+    parameters ``fixed``.
+    """
     specs = {s.name: s for s in scene.params}
     result: list[_Free] = []
     for label in free:
-        label = label.strip()
         match = _ITEM.match(label)
         if match is None or match["name"] not in specs:
             raise InvalidProblem(
@@ -162,14 +264,26 @@ def _free_coefficients(scene: Case, free: Sequence[str]) -> list[_Free]:
             raise InvalidProblem(
                 f"free coefficient {label!r}: {spec.name} is a {spec.kind}, not a number to fit"
             )
+        if index is not None:
+            _check_index(label, spec.name, index, len(fixed[spec.name]))
         low = -np.inf if spec.low is None else spec.low
         high = np.inf if spec.high is None else spec.high
         log = spec.low == 0.0 and spec.low_open and spec.high is None
-        result.append(_Free(label, spec.name, index, low, high, log))
+        result.append(_Free(label, spec, index, low, high, log))
     labels = [f.label for f in result]
     if not result or len(set(labels)) < len(labels):
         raise InvalidProblem(f"free = {list(free)}: give distinct coefficients, at least one")
     return result
+
+
+def _check_index(label: str, name: str, index: int, length: int) -> None:
+    """Refuse entry ``index`` of list parameter ``name`` when it has only ``length`` entries."""
+    if index >= length:
+        entries = f"1 entry ({name}[0])" if length == 1 else f"{length} entries"
+        last = "" if length == 1 else f" ({name}[0] to {name}[{length - 1}])"
+        raise InvalidProblem(
+            f"free coefficient {label!r}: {name} has {entries} at these parameters{last}"
+        )
 
 
 def _numeric(specs: Any) -> list[str]:
@@ -189,17 +303,22 @@ class FitResult:
     standard_errors : dict
         Coefficient -> standard error (inf when not identifiable, 0 with noise-free data).
     correlations : ndarray (p, p)
-        Correlations of the coefficients (NaN where a standard error is 0 or inf).
+        Correlations of the coefficients (NaN, undefined, where a standard error is 0, inf or
+        undefined).
     residuals : ndarray (trials,)
         Root mean square residual of each fitted trial (velocity units).
     rms : float
         Root mean square residual over every fitted velocity.
     sigma : float
-        Estimated noise standard deviation, sqrt(RSS / (N - p)) (NaN when N <= p).
+        Estimated noise standard deviation, sqrt(RSS / (N - p)) (NaN, undefined, when
+        N <= p; standard errors are then NaN too).
     singular_values : ndarray (p,)
         Singular values of the Jacobian in the fitted scale.
     non_identifiable : list of str
         Coefficients carrying a flat direction of the data.
+    unread : list of str
+        Coefficients the law's answer does not change with at any fitted trial (a zero column
+        of the Jacobian: the law does not read them); each is also not identifiable.
     fits : bool or None
         Whether the residual is compatible with ``noise`` (None when no noise was given).
     verdict : str
@@ -232,6 +351,7 @@ class FitResult:
     sigma: float
     singular_values: np.ndarray
     non_identifiable: list[str]
+    unread: list[str]
     fits: bool | None
     verdict: str
     params: dict[str, Any]
@@ -245,31 +365,34 @@ class FitResult:
     bootstrap: dict[str, np.ndarray] | None = None
 
     def text(self) -> str:
-        """A plain-text report: coefficients, correlations, residuals and verdicts."""
+        """A plain-text report: coefficients, correlations, residuals and verdicts.
+
+        An undefined number (a correlation of a coefficient that is not identifiable, a
+        standard error with no degree of freedom left) is printed as ``-``.
+        """
         lines = [f"{self.law} on {self.case}: {len(self.trials)} trials fitted ({self.message})"]
         lines.append(
             f"{'coefficient':<18}{'value':>14}{'std error':>14}"
             + (f"{'bootstrap sd':>14}{'2.5%':>12}{'97.5%':>12}" if self.bootstrap else "")
         )
-        for name, value in self.values.items():
-            row = f"{name:<18}{value:>14.6g}{self.standard_errors[name]:>14.3g}"
-            if self.bootstrap:
-                draws = self.bootstrap[name]
-                low, high = np.percentile(draws, [2.5, 97.5])
-                row += f"{np.std(draws, ddof=1):>14.3g}{low:>12.6g}{high:>12.6g}"
-            lines.append(row)
+        lines += [self._row(name) for name in self.values]
         if len(self.values) > 1:
-            lines.append("correlations:")
-            names = list(self.values)
-            for i, name in enumerate(names):
-                cells = " ".join(f"{c:>7.3f}" for c in self.correlations[i])
-                lines.append(f"  {name:<16}{cells}")
-        lines.append(f"rms residual {self.rms:.3g}, estimated noise sigma {self.sigma:.3g}")
+            lines.append("correlations (-: undefined):")
+            for name, row in zip(self.values, self.correlations, strict=True):
+                lines.append(f"  {name:<16}" + " ".join(_cell(c, 7, ".3f") for c in row))
+        sigma = "undefined (no more measured velocities than coefficients)"
+        sigma = sigma if math.isnan(self.sigma) else f"{self.sigma:.3g}"
+        lines.append(f"rms residual {self.rms:.3g}, estimated noise sigma {sigma}")
         lines.append("singular values of J: " + ", ".join(f"{s:.3g}" for s in self.singular_values))
         if self.non_identifiable:
             lines.append(
                 "not identifiable from these data (flat direction): "
                 + ", ".join(self.non_identifiable)
+            )
+        if self.unread:
+            lines.append(
+                f"not read by {self.law} (its answer does not change with them): "
+                + ", ".join(self.unread)
             )
         lines.append(f"verdict: {self.verdict}")
         lines.append("residual per trial (row: rms):")
@@ -281,6 +404,16 @@ class FitResult:
                 for i, r in zip(self.held_out, self.holdout_residuals, strict=True)
             ]
         return "\n".join(lines)
+
+    def _row(self, name: str) -> str:
+        """The line of coefficient ``name``: value, standard error, bootstrap spread."""
+        row = f"{name:<18}{self.values[name]:>14.6g}{_cell(self.standard_errors[name], 14, '.3g')}"
+        if self.bootstrap:
+            draws = self.bootstrap[name]
+            low, high = np.percentile(draws, [2.5, 97.5])
+            spread = float(np.std(draws, ddof=1)) if len(draws) > 1 else math.nan
+            row += f"{_cell(spread, 14, '.3g')}{low:>12.6g}{high:>12.6g}"
+        return row
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dictionary of the result."""
@@ -295,6 +428,7 @@ class FitResult:
             "sigma": _finite(self.sigma),
             "singular_values": self.singular_values.tolist(),
             "non_identifiable": self.non_identifiable,
+            "unread": self.unread,
             "fits": self.fits,
             "verdict": self.verdict,
             "trials": self.trials.tolist(),
@@ -314,6 +448,11 @@ class FitResult:
 
 def _finite(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
+
+
+def _cell(value: float, width: int, form: str) -> str:
+    """``value`` in ``form``, right-aligned in ``width``; an undefined value (NaN) as ``-``."""
+    return f"{'-' if math.isnan(value) else format(value, form):>{width}}"
 
 
 class _Model:
@@ -380,29 +519,34 @@ def fit(
         The scene of the experiment.
     data : path or DataFrame
         Trials: columns ``<coordinate>_minus`` and ``<coordinate>_plus`` (`columns`).
-    free : sequence of str
-        The coefficients to fit: parameter names, or ``name[i]`` for one entry of a list.
+    free : str or sequence of str
+        The coefficients to fit: parameter names, or ``name[i]`` for one entry of a list (an
+        index below the list's length at ``params``).
     params : mapping, optional
         Scene parameters held fixed (the others take their defaults).
     options : mapping, optional
         The law's options.
     start : mapping, optional
-        Starting value of a free coefficient; by default its value in ``params`` or its
-        default, moved inside the bounds.
+        Starting value of a free coefficient (a finite number, or its text, in the
+        parameter's range); by default its value in ``params`` or its default. Either is
+        moved inside the bounds by a millionth of their span.
     noise : float, optional
-        Standard deviation of a measured velocity; when given, the residual is judged.
+        Standard deviation of a measured velocity, in [1e-12, 1e6]; when given, the residual
+        is judged.
     holdout : float
-        Fraction of the trials held back from the fit (0 to < 1), chosen with ``seed``.
+        Fraction of the trials held back from the fit, in [0, 1), chosen with ``seed``.
     bootstrap : int
-        Number of refits on trials resampled with replacement (seeded by ``seed``).
+        Number of refits on trials resampled with replacement (seeded by ``seed``), in
+        [0, 100000].
     seed : int
-        Seed of the holdout split and the bootstrap resamples.
+        Seed of the holdout split and the bootstrap resamples, 0 or more.
     tol : float
-        ``ftol``, ``xtol`` and ``gtol`` of `scipy.optimize.least_squares`.
+        ``ftol``, ``xtol`` and ``gtol`` of `scipy.optimize.least_squares`, in [1e-15, 0.1].
     diff_step : float
-        Relative finite-difference step of the Jacobian (above the law's own accuracy).
+        Relative finite-difference step of the Jacobian (above the law's own accuracy), in
+        [1e-12, 0.1].
     flat_tol : float
-        Relative singular value below which a direction of the Jacobian is flat.
+        Relative singular value below which a direction of the Jacobian is flat, in [0, 0.5].
 
     Returns
     -------
@@ -411,7 +555,11 @@ def fit(
     Raises
     ------
     InvalidProblem
-        Bad data (naming row and column), an unknown coefficient, a bad option or value.
+        Bad data (naming row and column), an unknown coefficient or an entry past a list's
+        end, a bad option, a starting value or a number outside its range (`RANGES`).
+    TypeError
+        Naming the argument of the wrong type (``free`` not names, ``params`` not a mapping,
+        ``seed`` not an integer, ...).
     NotApplicable
         The law cannot treat the scene.
 
@@ -427,19 +575,23 @@ def fit(
     >>> round(result.values["e"], 8)
     0.5
     """
+    _check_numbers(
+        noise,
+        holdout=holdout,
+        bootstrap=bootstrap,
+        seed=seed,
+        tol=tol,
+        diff_step=diff_step,
+        flat_tol=flat_tol,
+    )
+    labels, start = _labels(free), _mapping("start", start)
     law_obj, scene = LAWS.get(law), CASES.get(case)
-    fixed = scene.parameters(**dict(params or {}))
-    law_opts = law_obj.option_values(dict(options or {}))
-    coefficients = _free_coefficients(scene, free)
+    fixed = scene.parameters(**_mapping("params", params))
+    law_opts = law_obj.option_values(_mapping("options", options))
+    coefficients = _free_coefficients(scene, labels, fixed)
     v_minus, v_plus = read_trials(data, scene, fixed)
-    if not 0.0 <= holdout < 1.0:
-        raise InvalidProblem(f"holdout = {holdout:g}: must lie in [0, 1)")
-    if bootstrap < 0:
-        raise InvalidProblem(f"bootstrap = {bootstrap}: must be 0 or more")
-    if noise is not None and not noise > 0:
-        raise InvalidProblem(f"noise = {noise:g}: must be a positive velocity")
     model = _Model(law_obj, scene, coefficients, fixed, law_opts)
-    x0 = _start(coefficients, fixed, dict(start or {}))
+    x0 = _start(coefficients, fixed, start)
     rng = np.random.default_rng(seed)
     count = len(v_minus)
     order = rng.permutation(count)
@@ -465,20 +617,26 @@ def fit(
     return result
 
 
-def _start(free: list[_Free], fixed: dict[str, Any], start: dict[str, float]) -> np.ndarray:
-    unknown = sorted(set(start) - {f.label for f in free})
+def _check_numbers(noise: float | None, **given: object) -> None:
+    """Refuse a numeric argument of `fit` of the wrong type or outside its range (`RANGES`)."""
+    if noise is not None:
+        given["noise"] = noise
+    for name, value in given.items():
+        RANGES[name].check(name, value)
+
+
+def _start(free: list[_Free], fixed: dict[str, Any], start: dict[str, Any]) -> np.ndarray:
+    unknown = sorted(set(start) - {f.label for f in free}, key=str)
     if unknown:
         raise InvalidProblem(f"start {unknown[0]!r}: not a free coefficient")
     x0 = []
     for f in free:
         if f.label in start:
-            value = float(start[f.label])
+            value = f.checked(start[f.label])
         else:
             given = fixed[f.name]
             value = float(given[f.index or 0] if isinstance(given, list) else given)
         if f.log:
-            if not value > 0:
-                raise InvalidProblem(f"start {f.label} = {value:g}: must be positive")
             x0.append(f.to_x(value))
             continue
         low, high = f.bounds()
@@ -546,26 +704,26 @@ def _summarize(
     cov = cov_x * np.outer(slope, slope)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     se[blocked] = np.inf
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(se, se)
-    corr[~np.isfinite(corr)] = np.nan
-    np.fill_diagonal(corr, [1.0 if math.isfinite(e) and e > 0 else np.nan for e in se])
     per_trial = np.sqrt((r.reshape(len(v_minus), -1) ** 2).mean(axis=1))
     fits, verdict = _judge(rss, dof, noise, v_minus, v_plus)
     non_identifiable = [f.label for f, b in zip(free, blocked, strict=True) if b]
+    unread = [f.label for f, column in zip(free, J.T, strict=True) if not column.any()]
     if non_identifiable:
         verdict += "; not identifiable: " + ", ".join(non_identifiable)
+    if unread:
+        verdict += f" ({model.law.name}'s answer does not change with {', '.join(unread)})"
     return FitResult(
         law="",
         case="",
         values=values,
         standard_errors={f.label: float(e) for f, e in zip(free, se, strict=True)},
-        correlations=corr,
+        correlations=_correlations(cov, se),
         residuals=per_trial,
         rms=math.sqrt(rss / n_res),
         sigma=sigma,
         singular_values=s,
         non_identifiable=non_identifiable,
+        unread=unread,
         fits=fits,
         verdict=verdict,
         params=model.params(solution.x),
@@ -574,6 +732,20 @@ def _summarize(
         message=str(solution.message),
         nfev=int(solution.nfev),
     )
+
+
+def _correlations(cov: np.ndarray, se: np.ndarray) -> np.ndarray:
+    """Correlations of the coefficients; NaN (undefined) where a standard error is 0 or inf.
+
+    A coefficient that is not identifiable (an infinite standard error) has no correlation
+    with any other: the pseudo-inverse's zero there says nothing of the data.
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+    defined = np.isfinite(se) & (se > 0)
+    corr[~np.outer(defined, defined) | ~np.isfinite(corr)] = np.nan
+    np.fill_diagonal(corr, np.where(defined, 1.0, np.nan))
+    return corr
 
 
 def _judge(

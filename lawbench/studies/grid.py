@@ -23,9 +23,12 @@ A parameter or option takes a list of values, one value, ``{range = [start, stop
 spaced), ``{logrange = [start_exponent, stop_exponent, count]}`` (powers of ten), or ``{random =
 [low, high, count], log = false, size = 1}`` (uniform samples, drawn from the spec's seed and the
 grid, parameter and draw position, so the same spec always gives the same values; ``size`` > 1 draws
-vectors). Rows are the Cartesian product in the order written: cases, then laws, then parameters,
-then options, then transforms. Every row is checked before any work: an unknown name or a value out
-of range raises `InvalidProblem`. A row is a `lawbench.checks.study.Job`; `RunSpec.plan` gives the
+vectors). A generator's bounds are finite, a ``random`` one's ``low <= high`` (both positive with
+``log = true``), its count at most `MAX_CELLS` and its ``size`` at most `MAX_SIZE`; a grid holds
+at most `MAX_CELLS` rows. Rows are the Cartesian product in the order written: cases, then laws,
+then parameters, then options, then transforms. A malformed generator raises `InvalidProblem` as
+the grid is read; every row is checked before any work: an unknown name or a value out of range
+raises `InvalidProblem`. A row is a `lawbench.checks.study.Job`; `RunSpec.plan` gives the
 executor's plan (`lawbench.studies.runner.run`). `RunSpec.count` counts the rows from the grid's
 sizes and `RunSpec.sample` builds a few of them alone, so a grid of millions of rows is sized and
 timed before it is built.
@@ -111,7 +114,8 @@ class RunSpec:
         return cls(grids, seed, checks, tuple(float(x) for x in sizes))
 
     def rows(self) -> list[Job]:
-        """Every row, in order, each checked against its law and case."""
+        """Every row, in order, each checked against its law and case (`count` first)."""
+        self.count()
         return [job for block in self._blocks() for job in block.rows()]
 
     def count(self) -> int:
@@ -120,16 +124,25 @@ class RunSpec:
         Per grid, the sum over its cases and laws of parameter sets x option sets x transforms,
         where a generator's grid points are counted, not drawn: a grid of millions of rows is
         counted as fast as one of ten.
+
+        Raises
+        ------
+        InvalidProblem
+            For a grid of more than `MAX_CELLS` rows, with its count.
         """
-        return sum(block.size for block in self._blocks())
+        total = sum(block.size for block in self._blocks())
+        if total > MAX_CELLS:
+            raise InvalidProblem(
+                f"spec: a grid of {total} cells, more than the {MAX_CELLS} a run holds"
+            )
+        return total
 
     def sample(self, count: int) -> list[Job]:
         """``count`` rows spread evenly over the grid (all of them when there are fewer).
 
         Each row is built alone, from its position: the rows around it are not built.
         """
-        blocks = list(self._blocks())
-        total = sum(block.size for block in blocks)
+        total, blocks = self.count(), list(self._blocks())
         wanted = sorted({k * total // count for k in range(count)}) if total else []
         jobs, start = [], 0
         for block in blocks:
@@ -184,6 +197,11 @@ class RunSpec:
 
 # Grid points of one parameter the echoed grid shows before it elides the middle ones.
 SHOWN = 6
+# Rows of a grid at most (a count above it is a typo: a billion cells take days on a cluster);
+# the grid points of one generator are bounded by it too.
+MAX_CELLS = 10**9
+# Entries of a random vector at most: the longest per-contact vector, a chain of 100000 balls.
+MAX_SIZE = 100_000
 GRID_KEYS = {"laws", "cases", "params", "options", "examples", "transforms"}
 _KINDS = {list: "an array", dict: "a table", bool: "true or false", str: "a string"}
 
@@ -213,10 +231,14 @@ def _check_grid(grid: Any, number: int) -> None:
     for key in ("laws", "cases", "transforms"):
         if key in grid:
             _strings(grid[key], f"{where}.{key}")
-    _typed(grid.get("params", {}), dict, f"{where}.params")
+    params = _typed(grid.get("params", {}), dict, f"{where}.params")
     _typed(grid.get("examples", False), bool, f"{where}.examples")
+    entries = [((number, "param", name), spec) for name, spec in params.items()]
     for law, options in _typed(grid.get("options", {}), dict, f"{where}.options").items():
         _typed(options, dict, f"{where}.options.{law}", "a table of option = values")
+        entries += [((number, "option", law, name), spec) for name, spec in options.items()]
+    for key, spec in entries:
+        grid_points(spec, 0, key)  # a generator checks its bounds, count and size
 
 
 def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
@@ -246,7 +268,7 @@ class _Block:
     @property
     def size(self) -> int:
         """The number of rows, counted without building them."""
-        return len(self.parameter_sets) * len(self.option_sets) * len(self.transforms)
+        return _size(self.parameter_sets) * _size(self.option_sets) * len(self.transforms)
 
     def rows(self) -> Iterator[Job]:
         """Every row, in order, each checked against its law and case."""
@@ -315,6 +337,11 @@ def _blocks(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[_Block]
             )
 
 
+def _size(points: Sequence[Any]) -> int:
+    """The length of ``points``, a `Product` of any size counted without `len`'s limit."""
+    return points.size if isinstance(points, Product) else len(points)
+
+
 def _listed(names: Any) -> str:
     return ",".join(names) if isinstance(names, list) else str(names)
 
@@ -325,20 +352,27 @@ def _shown(value: Any) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
-def parse_values(name: str, text: str) -> list[Any]:
+def parse_values(name: str, text: str, flag: str = "--param") -> list[Any]:
     """The grid points of a command-line value: ``0,0.5,1`` is three, ``[0.9,0.8]`` one vector.
 
     Commas outside brackets separate grid points; a bracketed list is one per-contact vector
-    (``[0.9,0.8],[1,1]`` is two). A point is a number where it reads as one, else a word.
+    (``[0.9,0.8],[1,1]`` is two), never nested. A point is a number where it reads as one, else
+    a word.
 
     Raises
     ------
     InvalidProblem
-        For an empty value, unbalanced brackets or a malformed vector, naming ``name``.
+        For an empty value, unbalanced or nested brackets or a malformed vector, naming
+        ``flag`` and ``name``.
     """
     items, depth, current = [], 0, ""
     for char in text:
         depth += (char == "[") - (char == "]")
+        if depth > 1:
+            raise InvalidProblem(
+                f"{flag} {name}={_quoted(text)}: nested brackets; a grid point is a number, a "
+                "word or one [vector] of numbers"
+            )
         if depth < 0:
             break
         if char == "," and depth == 0:
@@ -348,23 +382,35 @@ def parse_values(name: str, text: str) -> list[Any]:
             current += char
     items.append(current.strip())
     if depth != 0:
-        raise InvalidProblem(f"--param {name}={text}: unbalanced brackets")
+        raise InvalidProblem(f"{flag} {name}={_quoted(text)}: unbalanced brackets")
     if not all(items):
-        raise InvalidProblem(f"--param {name}={text}: an empty value")
-    return [_point(name, item) for item in items]
+        raise InvalidProblem(f"{flag} {name}={_quoted(text)}: an empty value")
+    return [_point(name, item, flag) for item in items]
 
 
-def _point(name: str, item: str) -> Any:
+# Characters of a typed value quoted in a message; a longer one is cut in the middle.
+QUOTED = 60
+
+
+def _quoted(text: str) -> str:
+    """``text`` as a message quotes it: at most `QUOTED` characters, the middle elided."""
+    if len(text) <= QUOTED:
+        return text
+    half = QUOTED // 2
+    return f"{text[:half]}...{text[-half:]} ({len(text)} characters)"
+
+
+def _point(name: str, item: str, flag: str) -> Any:
     try:
         value = json.loads(item)
-    except json.JSONDecodeError:
+    except (json.JSONDecodeError, RecursionError):  # braces nest: a word, or a bad vector
         if item.startswith("["):
-            raise InvalidProblem(f"--param {name}: malformed vector {item}") from None
+            raise InvalidProblem(f"{flag} {name}: malformed vector {_quoted(item)}") from None
         return item
     if isinstance(value, list) and not all(
         isinstance(v, int | float) and not isinstance(v, bool) for v in value
     ):
-        raise InvalidProblem(f"--param {name}: a vector holds numbers, got {item}")
+        raise InvalidProblem(f"{flag} {name}: a vector holds numbers, got {_quoted(item)}")
     return value if isinstance(value, int | float | list) else item
 
 
@@ -377,8 +423,13 @@ class Product(Sequence[dict[str, Any]]):
     def __init__(self, axes: Mapping[str, Sequence[Any]]) -> None:
         self.axes = dict(axes)
 
-    def __len__(self) -> int:
+    @property
+    def size(self) -> int:
+        """The number of entries, however many (`len` refuses more than ``sys.maxsize``)."""
         return math.prod(len(points) for points in self.axes.values())
+
+    def __len__(self) -> int:
+        return self.size
 
     @overload
     def __getitem__(self, index: int) -> dict[str, Any]: ...
@@ -409,7 +460,9 @@ class Generated(Sequence[Any]):
     Raises
     ------
     InvalidProblem
-        For an unknown generator or a malformed one, naming its key.
+        For an unknown generator or a malformed one, naming its key and what is wrong: bounds
+        that are not finite, a count outside [0, `MAX_CELLS`], a size outside [1, `MAX_SIZE`],
+        a random draw with ``low > high``, or with ``log = true`` and ``low <= 0``.
     """
 
     KINDS = ("range", "logrange", "random")
@@ -422,17 +475,37 @@ class Generated(Sequence[Any]):
             start, stop, count = spec[self.kind]
             self.start, self.stop, self.count = float(start), float(stop), int(count)
             self.width = int(spec.get("size", 1))
-        except (TypeError, ValueError) as exc:
+        except (TypeError, ValueError, OverflowError) as exc:
             raise InvalidProblem(
                 f"spec {_key(where)}: bad value generator {dict(spec)} ({exc})"
             ) from None
-        if self.count < 0 or self.width < 1:
-            raise InvalidProblem(
-                f"spec {_key(where)}: bad value generator {dict(spec)} (a negative count or size)"
-            )
         self.log = bool(spec.get("log", False))
+        problem = self._problem()
+        if problem:
+            raise InvalidProblem(
+                f"spec {_key(where)}: bad value generator {dict(spec)} ({problem})"
+            )
         digest = hashlib.sha1("/".join(str(part) for part in where).encode()).digest()
         self.seed = [seed, int.from_bytes(digest[:8], "little")]
+
+    def _problem(self) -> str:
+        """What is wrong with this generator's bounds, count or size ('' when nothing is)."""
+        low, high = self.start, self.stop
+        if not (math.isfinite(low) and math.isfinite(high)):
+            return f"its bounds {low:g} and {high:g} must be finite"
+        if not 0 <= self.count <= MAX_CELLS:
+            return f"a count of {self.count}, outside 0..{MAX_CELLS}"
+        if not 1 <= self.width <= MAX_SIZE:
+            return f"a size of {self.width}, outside 1..{MAX_SIZE}"
+        if self.kind != "random":
+            return ""
+        if low > high:
+            return f"low {low:g} is above high {high:g}"
+        if self.log and low <= 0:
+            return f"log = true draws between positive bounds, not from {low:g}"
+        if not math.isfinite(high - low):
+            return f"the span {low:g} to {high:g} exceeds floating point"
+        return ""
 
     def __len__(self) -> int:
         return self.count

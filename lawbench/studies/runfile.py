@@ -47,7 +47,7 @@ from filelock import FileLock, Timeout
 
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.verdicts import Verdict
-from lawbench.files.paths import output_file
+from lawbench.files.paths import input_file, output_file
 
 log = logging.getLogger("lawbench.studies.runner")
 # The grid an unfinished output belongs to, beside its chunks.
@@ -277,11 +277,28 @@ def _gathered(table: pd.DataFrame, vectors: Sequence[str]) -> pd.DataFrame:
 
 
 def read_table(path: Path) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """A run's tidy table and its metadata, from any of the three formats."""
+    """A run's tidy table and its metadata, from any of the three formats.
+
+    Raises
+    ------
+    InvalidProblem
+        Naming the file, for one that is not a table of its format (junk, a truncated file),
+        whose metadata is not JSON, or a CSV file's metadata sidecar that is not a regular file.
+    """
     path = Path(path)
     kind = file_format(path)
+    sidecar = _sidecar(path)
+    meta = _json(sidecar, "run metadata") if kind == "csv" and sidecar.exists() else {}
+    try:
+        return _read(path, kind, meta)
+    except (OSError, ValueError, pa.ArrowException) as exc:
+        reason = " ".join(str(exc).split())  # a reader's message may span lines
+        raise InvalidProblem(f"run table {path}: not a table a run wrote ({reason})") from None
+
+
+def _read(path: Path, kind: str, meta: dict[str, Any]) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """The table of ``path`` in format ``kind`` and its metadata (a CSV file's is ``meta``)."""
     if kind == "csv":
-        meta = json.loads(_sidecar(path).read_text()) if _sidecar(path).exists() else {}
         table = pd.read_csv(path, keep_default_na=False, na_values=[""])
         table = _gathered(table, _wide(meta))
         for name in _verdict_columns(table):
@@ -290,6 +307,24 @@ def read_table(path: Path) -> tuple[pd.DataFrame, dict[str, Any]]:
     arrow = pq.read_table(path) if kind == "parquet" else feather.read_table(path)
     meta = json.loads((arrow.schema.metadata or {}).get(META_KEY, b"{}"))
     return arrow.to_pandas(), meta
+
+
+def _json(path: Path, what: str) -> dict[str, Any]:
+    """The JSON object in the regular file ``path``; ``what`` names it in messages.
+
+    Raises
+    ------
+    InvalidProblem
+        For a path that is not a regular file, or text that is not a JSON object.
+    """
+    path = input_file(path, what)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:  # JSONDecodeError and UnicodeDecodeError included
+        raise InvalidProblem(f"{what} {path}: not JSON ({' '.join(str(exc).split())})") from None
+    if not isinstance(data, dict):
+        raise InvalidProblem(f"{what} {path}: a JSON {type(data).__name__}, not an object")
+    return data
 
 
 def load_run(path: str | os.PathLike[str]) -> pd.DataFrame:
@@ -310,11 +345,13 @@ def load_run(path: str | os.PathLike[str]) -> pd.DataFrame:
     Raises
     ------
     InvalidProblem
-        For an unknown extension or a file that does not exist.
+        For an unknown extension, a path that is not a regular file of bounded size (missing,
+        a FIFO, a folder: `lawbench.files.paths.input_file`), or a file that is not a run's
+        table.
+    TypeError
+        For a ``path`` that is not a path.
     """
-    if not Path(path).exists():
-        raise InvalidProblem(f"run file {path}: does not exist")
-    table, meta = read_table(Path(path))
+    table, meta = read_table(input_file(path, "run file"))
     table.attrs["lawbench"] = meta
     return table
 
@@ -379,7 +416,7 @@ class Store:
         """
         held: dict[str, Any] = {}
         if (self.parts / GRID_FILE).exists():
-            held = json.loads((self.parts / GRID_FILE).read_text())
+            held = _json(self.parts / GRID_FILE, "run grid")
         elif self.out.exists():
             held = read_table(self.out)[1]
         if held.get("grid", grid) != grid:
@@ -398,10 +435,19 @@ class Store:
 
         A chunk whose checksum is missing or wrong, or that cannot be read, is deleted, named in
         ``damaged`` and reported (logger ``lawbench.studies.runner``): its cells are computed again.
+
+        Raises
+        ------
+        InvalidProblem
+            When ``out`` holds a table no run wrote (`read_table`, or no ``key`` column).
         """
         frames = []
         if self.out.exists():
             table, meta = read_table(self.out)
+            if "key" not in table.columns:
+                raise InvalidProblem(
+                    f"--out {self.out}: a table no run wrote (no 'key' column): give another --out"
+                )
             self._layout = meta
             frames.append(untidy(table, meta))
         for path in self.chunks():

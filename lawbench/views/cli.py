@@ -441,7 +441,7 @@ def _inline_spec(args: argparse.Namespace) -> object:
         if targets == ["*"]:
             raise InvalidProblem(f"--option {name}: name the laws (--laws), or give LAW.{name}")
         for target in targets:
-            options.setdefault(target, {})[option] = parse_values(name, text)
+            options.setdefault(target, {})[option] = parse_values(name, text, "--option")
     grid = {
         "laws": laws,
         "cases": _names(args.cases, "--cases", CASES) or ["*"],
@@ -508,7 +508,7 @@ def _fit(args: argparse.Namespace) -> None:
     laws = [name.strip() for name in args.law.split(",") if name.strip()]
     if not laws:
         raise InvalidProblem("fit: give a law (or several, comma-separated)")
-    start = {k: float(_number(k, v)) for k, v in _assignments(args.start, "--start").items()}
+    start = _assignments(args.start, "--start")
     results = [
         fit(
             law,
@@ -533,13 +533,6 @@ def _fit(args: argparse.Namespace) -> None:
         print("\nlaws on the held-back trials (rms residual, best first):")
         for r in sorted(results, key=lambda r: r.holdout_rms or 0.0):
             print(f"  {r.law:<16}{r.holdout_rms:.4g}")
-
-
-def _number(name: str, text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise InvalidProblem(f"--start {name}={text!r}: not a number") from None
 
 
 def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
@@ -765,10 +758,16 @@ def build_parser() -> argparse.ArgumentParser:
         "--option", action="append", default=[], metavar="NAME=VALUE", help="a law option"
     )
     fitp.add_argument(
-        "--start", action="append", default=[], metavar="NAME=VALUE", help="a starting value"
+        "--start",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a starting value, in the parameter's range",
     )
     fitp.add_argument(
-        "--noise", type=float, help="standard deviation of a measured velocity (judges the fit)"
+        "--noise",
+        type=float,
+        help="standard deviation of a measured velocity, in [1e-12, 1e6] (judges the fit)",
     )
     fitp.add_argument(
         "--holdout", type=_fraction, default=0.0, metavar="FRACTION", help="trials held back"
