@@ -80,6 +80,14 @@ frictionless formulations above do not depend on it:
   the fixed point's interior-point steps still find the contact states. Diagnostics:
   ``sweeps`` (and ``iterations``, the same), ``polished``, ``fc3d_error``.
 
+An answer that leaves a contact approaching (``un+ + e r`` below ``-sqrt(tol)`` of the largest
+local velocity) breaks the normal law: with ``mu`` near 1e300 the modified velocity loses ``un``
+to rounding and a zero impulse passes the cone conditions. With one contact the law's states
+are then enumerated exactly (take-off, stick, slip: `lawbench.numerics.gauss_seidel.one_contact`)
+and the one that holds is the answer; when none holds, as on the lamina with ``mu |h0| > |f0|``
+and ``e > 0``, the law has no solution and raises `NotApplicable`. With several contacts it is a
+`SolverFailure`.
+
 ``polish`` refines each cone QP's answer and the final one on the contact states they show
 (Newton's method on the equations of each state) and keeps a refinement when it satisfies the
 cone conditions better; an answer clarabel only 'AlmostSolved' must be refined or raises
@@ -100,7 +108,7 @@ import numpy as np
 
 from lawbench.checks.regions import coupled_friction, option, separating_contact
 from lawbench.core import budget
-from lawbench.core.errors import InvalidProblem, SolverFailure
+from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import is_diagonal
 from lawbench.core.outcome import Outcome
@@ -115,7 +123,7 @@ from lawbench.laws._claims import (
     separating_held,
 )
 from lawbench.numerics import cones
-from lawbench.numerics.gauss_seidel import COMPILED, error_of, solve_nsgs
+from lawbench.numerics.gauss_seidel import COMPILED, error_of, one_contact, solve_nsgs
 from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
 
 if TYPE_CHECKING:
@@ -300,24 +308,47 @@ def _resolve_friction(
     q[:m] += restitution
     solve = _gauss_seidel if options["method"] == "nsgs" else _fixed_point
     P, diagnostics = solve(G, q, mu, d, options)
-    _refuse_approaching(G @ P + q, m, options["tol"], float(np.abs(q).max()))
+    if _approaching(G @ P + q, m, options["tol"], float(np.abs(q).max())):
+        P = _one_contact_or_refuse(G, q, mu)
+        diagnostics["formulation"] += ", then the contact's exact state"
     return Outcome.from_impulses(problem, P[:m], P[m:], diagnostics=diagnostics)
 
 
-def _refuse_approaching(u: np.ndarray, m: int, tol: float, scale: float) -> None:
-    """Raise `SolverFailure` where a contact still approaches after the impact.
+def _approaching(u: np.ndarray, m: int, tol: float, scale: float) -> bool:
+    """Whether a contact still approaches after the impact, breaking ``un+ + E r >= 0``.
 
-    The normal law holds ``un+ + E r >= 0`` (``u``'s first m entries); an answer far below,
-    by more than ``sqrt(tol)`` of the largest local velocity, is rounding's: with ``mu`` near
-    1e300 the modified velocity ``un + mu |ut|`` loses ``un`` entirely, and a zero impulse
-    passes the cone conditions while the contact goes on approaching.
+    ``u`` is ``G P + q``; below ``-sqrt(tol)`` of the largest local velocity ``scale`` the
+    answer breaks the normal law. With ``mu`` near 1e300 the modified velocity
+    ``un + mu |ut|`` loses ``un`` to rounding, and a zero impulse passes the cone conditions
+    while the contact goes on approaching.
     """
-    j = int(np.argmin(u[:m]))
-    if u[j] < -(tol**0.5) * scale:
+    return bool(u[:m].min() < -(tol**0.5) * scale)
+
+
+def _one_contact_or_refuse(G: np.ndarray, q: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """The exact state of a one-contact problem the solver missed, or the reason there is none.
+
+    Raises
+    ------
+    NotApplicable
+        When take-off, stick and slip all fail (`gauss_seidel.one_contact`): the law has no
+        solution.
+    SolverFailure
+        With several contacts, where the states are not enumerated.
+    """
+    if len(mu) > 1:
         raise SolverFailure(
-            f"moreau: contact {j} still approaches after the impact (un+ + e r = {u[j]:.3g}): "
-            "the cone conditions hold only to rounding here"
+            "moreau: a contact still approaches after the impact: the cone conditions hold "
+            "only to rounding here"
         )
+    P = one_contact(G, q, mu[0])
+    if P is None:
+        raise NotApplicable(
+            "moreau: take-off, stick and slip all fail at this contact: with kinematic "
+            "restitution and Coulomb friction the law has no solution when the normal and "
+            "tangential directions are this strongly coupled (as in Painleve's examples)"
+        )
+    return P
 
 
 def _fixed_point(
@@ -375,6 +406,10 @@ def _gauss_seidel(
         refined_error = np.inf if refined is None else error_of(G, q, mu, d, refined)
         if refined_error <= error:
             P, error, polished = refined, refined_error, True
+    if error > tol and len(mu) == 1:
+        # One contact's states decide: its exact one, or the reason the law has none.
+        P, polished = _one_contact_or_refuse(G, q, mu), False
+        error = error_of(G, q, mu, d, P)
     if error > tol:
         raise SolverFailure(
             f"Gauss-Seidel stationary after {result.sweeps} sweeps at FC3D error {error:.3g}, "

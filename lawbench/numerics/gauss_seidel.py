@@ -242,6 +242,15 @@ def solve_contact(
         ``P`` with ``K ∋ P _|_ (un + mu |ut|, ut) ∈ K*`` (the module's docstring gives the
         states and their sources).
     """
+    P = _in_a_state(W, inverse, b, mu, current)
+    return P if P.size else _projected(W, b, mu, current)
+
+
+@_compiled
+def _in_a_state(
+    W: np.ndarray, inverse: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray
+) -> np.ndarray:
+    """`solve_contact`'s take-off, stick or slip impulse; empty when no state holds."""
     P = np.zeros(b.size)
     if b[0] >= 0.0:
         return P
@@ -253,10 +262,19 @@ def solve_contact(
         stick = -(inverse @ b)
         if stick[0] > 0.0 and np.linalg.norm(stick[1:]) <= mu * stick[0]:
             return stick
-    slip = _slip(W, b, mu, current)
-    if slip.size:
-        return slip
-    return _projected(W, b, mu, current)
+    return _slip(W, b, mu, current)
+
+
+def one_contact(G: np.ndarray, q: np.ndarray, mu: float) -> np.ndarray | None:
+    """The impulse of a one-contact problem ``u = G P + q`` in its exact state, or None.
+
+    None when neither take-off, stick nor slip holds: no impulse in the Coulomb cone satisfies
+    the law (Coulomb's law with kinematic restitution can have no solution when the normal
+    and tangential directions are strongly coupled, as Painlevé's examples).
+    """
+    G = np.asarray(G, dtype=float)
+    P = _in_a_state(G, inverses(G[None])[0], np.asarray(q, dtype=float), mu, np.zeros(q.size))
+    return P if P.size else None
 
 
 @_compiled
