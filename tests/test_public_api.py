@@ -109,6 +109,10 @@ def test_run_checks_on_a_problem_of_your_own():
         (lambda: lawbench.plot_path("x"), "outcome must be an Outcome or a Trial"),
         (lambda: lawbench.plot_sweep("table", "x", "y"), "frame must be a pandas DataFrame"),
         (lambda: lawbench.save_problem(None, "p.json"), "problem must be an ImpactProblem"),
+        (
+            lambda: lawbench.ProblemBatch(np.eye(2), [[-1.0], [1.0]], [[1.0, 0.0]], "x"),
+            "coefficients must be a mapping",
+        ),
         (lambda: lawbench.check_law("newton", random_problems=1.5), "random_problems must be"),
         (
             lambda: lawbench.ImpactProblem.from_arrays(
@@ -159,6 +163,12 @@ def test_a_problem_with_a_vector_that_is_not_numeric_is_invalid_naming_it():
         (
             lambda: lawbench.ImpactProblem.from_arrays(np.eye(2), [[-1.0, 0.0], [1.0]], [1, 0]),
             "Wn: not an array of numbers",
+        ),
+        (
+            lambda: lawbench.ImpactProblem.from_arrays(
+                [[1.0, 0.0], [0.0]], [[-1.0], [1.0]], [1, 0]
+            ),
+            "M: not an array of numbers",
         ),
         (
             lambda: lawbench.ImpactProblem.from_arrays(

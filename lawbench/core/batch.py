@@ -15,7 +15,7 @@ Jacobian, zero gaps): the problems where many small impacts are solved at once.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -103,6 +103,11 @@ class ProblemBatch:
         set_(self, "Wn", _stack("Wn", self.Wn, (n, m), batch))
         for name in (f for f in ("M", "Wn") if getattr(self, f).shape[0] != batch):
             raise InvalidProblem(f"{name} holds {getattr(self, name).shape[0]} problems, v {batch}")
+        if not isinstance(self.coefficients, Mapping):
+            raise TypeError(
+                "coefficients must be a mapping of coefficient names to values, not "
+                f"{type(self.coefficients).__name__}"
+            )
         coefficients = {}
         for name, value in self.coefficients.items():
             if name not in COEFFICIENTS:

@@ -257,11 +257,13 @@ def _matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`."""
     if is_sparse(value):
         value = value.toarray()
-    if np.iscomplexobj(value):
-        raise InvalidProblem(f"{name}: complex numbers; a problem holds real ones")
     try:
+        if np.iscomplexobj(value):
+            raise InvalidProblem(f"{name}: complex numbers; a problem holds real ones")
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
+        if isinstance(exc, InvalidProblem):
+            raise
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
     if array.shape != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
