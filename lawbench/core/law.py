@@ -3,9 +3,10 @@
 A law subclasses `Law`, declares its name, summary, source, tags, options, findings and
 guarantees, and implements `Law._resolve`. `Law.resolve` does what is common to all of them: it
 checks the options and the problem against the tags, restricts the problem to its closed contacts
-(a contact with a positive gap is not part of this impact), times the solve within the budget
-its options set (`lawbench.core.budget`: every law has ``max_seconds``), and refuses to return a
-non-finite answer.
+(a contact with a positive gap is not part of this impact), solves a problem of extreme scale in
+units near it and scales the answer back (`ImpactProblem.units`), times the solve within the
+budget its options set (`lawbench.core.budget`: every law has ``max_seconds``), and refuses to
+return a non-finite answer.
 """
 
 from __future__ import annotations
@@ -122,7 +123,9 @@ class Law(ABC):
         Outcome
             With ``diagnostics['wall_time_s']`` and ``diagnostics['options']`` filled in, and
             ``diagnostics['warnings']`` where the solve raised warnings (a library's, or a
-            floating-point overflow): they are kept with the answer, never printed.
+            floating-point overflow): they are kept with the answer, never printed; and
+            ``diagnostics['units']`` where a scale-free law solved in other units of mass,
+            velocity and time (its path and other diagnostics are in those units).
 
         Raises
         ------
