@@ -215,7 +215,7 @@ def test_a_starting_value_is_a_finite_number_in_the_parameter_s_range(value, mes
         ("seed", -1, r"seed = -1: must lie in \[0, inf\)"),
         ("tol", 0, r"tol = 0: must lie in \[1e-15, 0.1\]"),
         ("tol", -1.0, "tol = -1: must lie in"),
-        ("tol", float("nan"), "tol = nan: must lie in"),
+        ("tol", float("nan"), "tol = nan: must be a finite number"),
         ("holdout", 1.0, r"holdout = 1: must lie in \[0, 1\)"),
         ("bootstrap", -1, "bootstrap = -1: must lie in"),
         ("diff_step", 0.0, "diff_step = 0: must lie in"),

@@ -37,8 +37,8 @@ class Spec:
         'float', 'int', 'bool', 'str', or 'floats' (a list; a single number is a list of one).
     low, high : float or None
         Bounds of a number, or of every number of a list.
-    low_open : bool
-        Whether ``low`` itself is excluded.
+    low_open, high_open : bool
+        Whether ``low`` or ``high`` itself is excluded.
     choices : tuple of str or None
         The allowed values of a 'str'.
     """
@@ -52,6 +52,7 @@ class Spec:
     high: float | None = None
     low_open: bool = False
     choices: tuple[str, ...] | None = None
+    high_open: bool = False
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -66,7 +67,7 @@ class Spec:
         if self.low is None and self.high is None:
             return "any"
         low = "-inf" if self.low is None else f"{self.low:g}"
-        high = "inf)" if self.high is None else f"{self.high:g}]"
+        high = "inf)" if self.high is None else f"{self.high:g}{')' if self.high_open else ']'}"
         return f"{'(' if self.low_open or self.low is None else '['}{low}, {high}"
 
     def coerce(self, value: Any) -> Any:
@@ -122,7 +123,9 @@ class Spec:
         too_low = self.low is not None and (
             number < self.low or (self.low_open and number == self.low)
         )
-        too_high = self.high is not None and number > self.high
+        too_high = self.high is not None and (
+            number > self.high or (self.high_open and number == self.high)
+        )
         if too_low or too_high:
             raise InvalidProblem(f"{label} = {number:g}: must lie in {self.describe_range()}")
         return number

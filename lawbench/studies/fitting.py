@@ -62,51 +62,22 @@ CHI2_QUANTILE = 0.999
 _ITEM = re.compile(r"^(?P<name>[A-Za-z_]\w*)(\[(?P<index>\d+)\])?$")
 
 
-@dataclass(frozen=True)
-class _Range:
-    """The values a numeric argument of `fit` may take: a real or an integer in an interval."""
-
-    low: float
-    high: float
-    whole: bool = False
-    high_open: bool = False
-
-    def check(self, name: str, value: object) -> None:
-        """Refuse ``value`` of argument ``name`` unless it is a number in this range.
-
-        Raises
-        ------
-        TypeError
-            For a value that is not a number (a bool is not), or not an integer where one is due.
-        InvalidProblem
-            For a value outside the range, naming the argument, the value and the range.
-        """
-        kind = numbers.Integral if self.whole else numbers.Real
-        if not isinstance(value, kind) or isinstance(value, bool):
-            wanted = "an integer" if self.whole else "a real number"
-            raise TypeError(f"{name} must be {wanted}, not {type(value).__name__}")
-        number = int(value) if self.whole else float(value)
-        below_high = number < self.high if self.high_open else number <= self.high
-        if not (self.low <= number and below_high):  # NaN fails both comparisons
-            shown = f"{number}" if self.whole else f"{number:g}"
-            raise InvalidProblem(f"{name} = {shown}: must lie in {self}")
-
-    def __str__(self) -> str:
-        closing = ")" if self.high_open or math.isinf(self.high) else "]"
-        return f"[{self.low:g}, {self.high:g}{closing}"
-
-
 # The ranges of fit's numeric arguments. The noise is the standard deviation of a measured
 # velocity: below 1e-12 m/s no measurement resolves a velocity, above 1e6 m/s it measures
 # nothing; scipy's tolerances must exceed the machine epsilon.
 RANGES = {
-    "noise": _Range(1e-12, 1e6),
-    "holdout": _Range(0.0, 1.0, high_open=True),
-    "bootstrap": _Range(0, 100_000, whole=True),
-    "seed": _Range(0, math.inf, whole=True),
-    "tol": _Range(1e-15, 0.1),
-    "diff_step": _Range(1e-12, 0.1),
-    "flat_tol": _Range(0.0, 0.5),
+    spec.name: spec
+    for spec in (
+        Spec("noise", None, "a measured velocity's standard deviation", "m/s", "float", 1e-12, 1e6),
+        Spec("holdout", 0.0, "share of the trials kept out", "", "float", 0.0, 1.0, high_open=True),
+        Spec("bootstrap", 0, "refits on resampled trials", "", "int", 0, 100_000),
+        Spec("seed", 0, "seed of the resampling", "", "int", 0),
+        Spec("tol", 1e-10, "tolerance of the least squares", "", "float", 1e-15, 0.1),
+        Spec("diff_step", 1e-6, "relative step of the finite differences", "", "float", 1e-12, 0.1),
+        Spec(
+            "flat_tol", FLAT_TOL, "singular value ratio of a flat direction", "", "float", 0.0, 0.5
+        ),
+    )
 }
 
 
@@ -622,7 +593,14 @@ def _check_numbers(noise: float | None, **given: object) -> None:
     if noise is not None:
         given["noise"] = noise
     for name, value in given.items():
-        RANGES[name].check(name, value)
+        spec = RANGES[name]
+        whole = spec.kind == "int"
+        if not isinstance(value, numbers.Integral if whole else numbers.Real) or isinstance(
+            value, bool
+        ):
+            wanted = "an integer" if whole else "a real number"
+            raise TypeError(f"{name} must be {wanted}, not {type(value).__name__}")
+        spec.coerce(value)
 
 
 def _start(free: list[_Free], fixed: dict[str, Any], start: dict[str, Any]) -> np.ndarray:
