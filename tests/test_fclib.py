@@ -294,3 +294,29 @@ def test_a_matrix_too_large_to_hold_or_not_numeric_is_refused(tmp_path, key, val
         group.create_dataset(key, data=np.atleast_1d(value))
     with pytest.raises(lawbench.InvalidProblem, match=message):
         read_fclib(path)
+
+
+@pytest.mark.parametrize("case", ["billiard", "sphere_wall"])
+def test_siconos_reads_and_solves_what_lawbench_writes(tmp_path, case):
+    """Siconos' own FCLIB readers take lawbench's local and global files.
+
+    Its NSGS (fc3d_nsgs) then finds the impulses Moreau's law gives on the same problem: at one
+    frictional contact or two, where the Coulomb problem has one solution, they agree to 1e-8.
+    Siconos' global reader copies ``nz`` indices whatever the storage, so lawbench writes
+    triplets; the test runs wherever the ``siconos`` package is importable.
+    """
+    sn = pytest.importorskip("siconos.numerics", reason="Siconos' Python package is not installed")
+    problem = lawbench.CASES[case].build(e=0.0)
+    local, global_ = tmp_path / "local.hdf5", tmp_path / "global.hdf5"
+    write_fclib(problem, local, "local")
+    write_fclib(problem, global_, "global")
+    read = sn.globalFrictionContact_fclib_read(str(global_))
+    assert read.numberOfContacts == problem.m
+    siconos_problem = sn.frictionContact_fclib_read(str(local))
+    r, u = np.zeros(3 * problem.m), np.zeros(3 * problem.m)
+    options = sn.SolverOptions(sn.SICONOS_FRICTION_3D_NSGS)
+    options.iparam[0], options.dparam[0] = 10_000, 1e-12
+    assert sn.fc3d_nsgs(siconos_problem, r, u, options) == 0
+    outcome = lawbench.solve("moreau", read_fclib(local))
+    ours = np.column_stack([outcome.Pn, outcome.Pt.reshape(problem.m, 2)]).ravel()
+    np.testing.assert_allclose(r, ours, atol=1e-8)

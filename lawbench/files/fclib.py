@@ -136,12 +136,22 @@ def _within(index: np.ndarray, bound: int, where: str) -> None:
 
 
 def _write_matrix(group: Any, matrix: np.ndarray) -> None:
-    csc = scipy.sparse.csc_matrix(matrix)
-    for key, value in (("nzmax", csc.nnz), ("m", csc.shape[0]), ("n", csc.shape[1]), ("nz", -1)):
+    """Write ``matrix`` in triplets (``nz`` entries, rows in ``i``, columns in ``p``).
+
+    Siconos' global reader copies ``nz`` indices whatever the storage, so a compressed matrix
+    (``nz = -1``) crashes it; triplets are read by every reader of the format.
+    """
+    coo = scipy.sparse.coo_matrix(matrix)
+    for key, value in (
+        ("nzmax", coo.nnz),
+        ("m", coo.shape[0]),
+        ("n", coo.shape[1]),
+        ("nz", coo.nnz),
+    ):
         group.create_dataset(key, data=np.array([value], dtype=np.int32))
-    group.create_dataset("p", data=csc.indptr.astype(np.int32))
-    group.create_dataset("i", data=csc.indices.astype(np.int32))
-    group.create_dataset("x", data=csc.data.astype(float))
+    group.create_dataset("p", data=coo.col.astype(np.int32))
+    group.create_dataset("i", data=coo.row.astype(np.int32))
+    group.create_dataset("x", data=coo.data.astype(float))
 
 
 def _vector(group: Any, key: str, where: str) -> np.ndarray:
