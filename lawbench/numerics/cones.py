@@ -266,6 +266,7 @@ def polish(
     states = _states(G, q, mu, d, P, coupled)
     free = ~_fixed(mu, d, states)
     exact = np.where(free, P, 0.0)
+    worst = np.inf
     for _ in range(NEWTON_STEPS):
         # A slip whose speed Newton's steps drive to zero leaves its direction undecided: the
         # approximate solution then stands.
@@ -273,6 +274,13 @@ def polish(
             F, J = _newton_system(G, q, mu, d, exact, coupled, states)
         if not (np.isfinite(F).all() and np.isfinite(J).all()):
             return None
+        # Newton's method on equations that hold converges quadratically; equations that a
+        # singular system cannot meet stall, and each further dense step costs O(n^3) for
+        # nothing: stop once a step no longer halves the largest equation's residual.
+        largest = float(np.abs(F[free]).max()) if free.any() else 0.0
+        if largest > worst / 2:
+            break
+        worst = largest
         step = np.linalg.lstsq(J[np.ix_(free, free)], -F[free], rcond=None)[0]
         exact[free] += step
         if not step.size or np.abs(step).max() <= 4 * EPS * max(np.abs(exact).max(), 1e-300):
