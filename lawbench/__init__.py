@@ -7,6 +7,9 @@ read-only registries `LAWS`, `CASES` and ``lawbench.checks.declared.STUDIES``; e
 result carries a `Verdict`. `solve_batch` solves many problems of one shape, `fit` identifies
 a law's coefficients from measured velocities, `check_law` holds any law to the common checks,
 `load_problem` and `save_problem` read and write problem files, `load_run` reads a run table.
+A `ContactProblem` is Coulomb's frictional contact problem in contact space (FCLIB's local
+form, ``W``, ``q``, ``mu`` as given), solved by a law's ``solve_contact`` into a
+`ContactSolution`.
 
 The package is built in layers, each importing only those below it::
 
@@ -24,6 +27,7 @@ import importlib
 
 from lawbench.checks import CHECKS, CheckResult, run_checks
 from lawbench.core.case import CASES, Case, GroundTruth, Reference
+from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import (
     BudgetExceeded,
     InvalidProblem,
@@ -86,6 +90,8 @@ __all__ = [
     "CheckResult",
     "Claim",
     "Contact",
+    "ContactProblem",
+    "ContactSolution",
     "FitResult",
     "GroundTruth",
     "ImpactProblem",

@@ -105,14 +105,16 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import scipy.sparse
 
 from lawbench.checks.regions import coupled_friction, option, separating_contact
 from lawbench.core import budget
+from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
-from lawbench.core.mechanics import is_diagonal
+from lawbench.core.mechanics import fc3d_error, is_diagonal
 from lawbench.core.outcome import Outcome
-from lawbench.core.problem import ImpactProblem
+from lawbench.core.problem import ImpactProblem, as_array
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
@@ -123,7 +125,14 @@ from lawbench.laws._claims import (
     separating_held,
 )
 from lawbench.numerics import cones
-from lawbench.numerics.gauss_seidel import COMPILED, error_of, one_contact, solve_nsgs
+from lawbench.numerics.gauss_seidel import (
+    COMPILED,
+    error_of,
+    in_local_order,
+    local_order,
+    one_contact,
+    solve_nsgs,
+)
 from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
 
 if TYPE_CHECKING:
@@ -203,9 +212,9 @@ class Moreau(Law):
         ),
         Spec(
             "max_steps",
-            1000,
+            100_000,
             "bound on the cone QPs of the exact Coulomb law's fixed point, or on the sweeps of "
-            "Gauss-Seidel",
+            "Gauss-Seidel (granular problems take thousands); max_seconds bounds either",
             "",
             "int",
             1,
@@ -240,19 +249,23 @@ class Moreau(Law):
         ),
     )
 
-    def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+    @staticmethod
+    def _refuse_relaxed_nsgs(options: dict[str, Any]) -> None:
         if options["method"] == "nsgs" and options["friction"] == "relaxed":
             raise InvalidProblem(
                 "moreau: method 'nsgs' solves Coulomb's law exactly; Anitescu's relaxation "
                 "(friction 'relaxed') is solved by method 'fixed_point'"
             )
+
+    def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        self._refuse_relaxed_nsgs(options)
         e, un = problem.restitution("kinematic"), problem.un
         if options["separating"] == "unilateral":
             restituted = np.minimum(un, 0.0)
         else:
             restituted = un
         if problem.frictional:
-            return _resolve_friction(problem.dense(), e * restituted, options)
+            return _resolve_friction(problem, e * restituted, options)
         large = problem.m > ENUMERATION_MAX
         single_e = large and len(set(e)) == 1 and np.array_equal(restituted, un)
         if single_e and large and not is_diagonal(problem.delassus):
@@ -279,6 +292,30 @@ class Moreau(Law):
         }
         return Outcome.from_impulses(problem, Pn, diagnostics=diagnostics)
 
+    def _solve_contact(
+        self, problem: ContactProblem, options: dict[str, Any]
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Coulomb's law on ``W``, ``q`` as given: the impact with ``e = 0`` in contact space.
+
+        ``nsgs`` sweeps ``W`` itself. The fixed point's cone QPs need a symmetric matrix: they
+        take ``W``'s symmetric part, which moves the answer by about ``W``'s asymmetry, so they
+        solve a ``W`` whose asymmetry is at most ``tol`` and refuse any other.
+        """
+        if options["method"] == "nsgs":
+            self._refuse_relaxed_nsgs(options)
+            return _nsgs(problem.W, problem.q, problem.mu, problem.dim, options)
+        if problem.asymmetry > options["tol"]:
+            raise NotApplicable(
+                f"moreau: method 'fixed_point' solves cone QPs, whose matrix is symmetric, and "
+                f"this W's asymmetry is {problem.asymmetry:.3g} (above tol = {options['tol']:g}); "
+                "method 'nsgs' solves W as given"
+            )
+        m, d = problem.m, problem.dim - 1
+        back = np.argsort(local_order(m, d))
+        G = problem.W[back][:, back].toarray()
+        P, diagnostics = _fixed_point((G + G.T) / 2, problem.q[back], problem.mu, d, options)
+        return P[local_order(m, d)], diagnostics
+
     def _resolve_batch(
         self, batch: ProblemBatch, options: dict[str, Any]
     ) -> tuple[np.ndarray, str] | None:
@@ -301,13 +338,18 @@ def _resolve_friction(
 ) -> Outcome:
     """Impulses in the Coulomb cones by the method of option ``method``.
 
-    ``restitution`` is ``E r``, added to the normal local velocities.
+    ``restitution`` is ``E r``, added to the normal local velocities. Gauss-Seidel sweeps the
+    contact Delassus matrix as it comes (sparse for a sparse problem); the fixed point's cone
+    QPs and polish take it dense.
     """
     m, d, mu, G = problem.m, problem.d, problem.mu, problem.contact_delassus
-    q = problem.W.T @ problem.v
+    q = np.asarray(problem.W.T @ problem.v)
     q[:m] += restitution
-    solve = _gauss_seidel if options["method"] == "nsgs" else _fixed_point
-    P, diagnostics = solve(G, q, mu, d, options)
+    if options["method"] == "nsgs":
+        P, diagnostics = _gauss_seidel(G, q, mu, d, options)
+    else:
+        G = as_array(G)
+        P, diagnostics = _fixed_point(G, q, mu, d, options)
     if _approaching(G @ P + q, m, options["tol"], float(np.abs(q).max())):
         P = _one_contact_or_refuse(G, q, mu)
         diagnostics["formulation"] += ", then the contact's exact state"
@@ -341,7 +383,7 @@ def _one_contact_or_refuse(G: np.ndarray, q: np.ndarray, mu: np.ndarray) -> np.n
             "moreau: a contact still approaches after the impact: the cone conditions hold "
             "only to rounding here"
         )
-    P = one_contact(G, q, mu[0])
+    P = one_contact(as_array(G), q, mu[0])
     if P is None:
         raise NotApplicable(
             "moreau: take-off, stick and slip all fail at this contact: with kinematic "
@@ -391,29 +433,62 @@ def _fixed_point(
 def _gauss_seidel(
     G: np.ndarray, q: np.ndarray, mu: np.ndarray, d: int, options: dict[str, Any]
 ) -> tuple[np.ndarray, dict[str, Any]]:
-    """Nonsmooth Gauss-Seidel, then `cones.polish` where it lowers the FC3D error.
+    """`_nsgs` on the Delassus matrix of lawbench's order, in FCLIB's order and back.
+
+    Raises
+    ------
+    NotApplicable, SolverFailure
+        As `_nsgs`; at one contact a stationary iteration is replaced by the contact's exact
+        state, or the reason the law has none.
+    """
+    m = len(mu)
+    order = local_order(m, d)
+    W, local_q = in_local_order(G, q, m, d)
+    try:
+        local_P, diagnostics = _nsgs(W, local_q, mu, d + 1, options)
+    except SolverFailure:
+        if m > 1:
+            raise
+        # One contact's states decide: its exact one, or the reason the law has none.
+        P = _one_contact_or_refuse(G, q, mu)
+        diagnostics = {"formulation": "the contact's exact state", "solver_status": "enumerated"}
+        diagnostics["fc3d_error"] = error_of(G, q, mu, d, P)
+        return P, diagnostics
+    P = np.empty_like(local_P)
+    P[order] = local_P
+    return P, diagnostics
+
+
+def _nsgs(
+    W: Any, q: np.ndarray, mu: np.ndarray, dim: int, options: dict[str, Any]
+) -> tuple[np.ndarray, dict[str, Any]]:
+    """Nonsmooth Gauss-Seidel in FCLIB's order; `cones.polish` where the sweeps stall.
+
+    A polish (dense Newton steps) of an answer already within ``tol`` would cost more than the
+    sweeps: it is tried only on an iteration that became stationary above ``tol``, and kept
+    where it lowers the FC3D error.
 
     Raises
     ------
     SolverFailure
         When the sweeps became stationary above ``tol`` and the polish did not reach it.
     """
-    tol = options["tol"]
-    result = solve_nsgs(G, q, mu, d, tol)
+    tol, m = options["tol"], len(mu)
+    result = solve_nsgs(W, q, mu, dim, tol)
     P, error, polished = result.P, result.error, False
-    if options["polish"]:
-        refined = cones.polish(G, q, mu, d, P, True)
-        refined_error = np.inf if refined is None else error_of(G, q, mu, d, refined)
-        if refined_error <= error:
-            P, error, polished = refined, refined_error, True
-    if error > tol and len(mu) == 1:
-        # One contact's states decide: its exact one, or the reason the law has none.
-        P, polished = _one_contact_or_refuse(G, q, mu), False
-        error = error_of(G, q, mu, d, P)
+    if error > tol and options["polish"]:
+        back = np.argsort(local_order(m, dim - 1))
+        G, lawbench_q = scipy.sparse.csr_matrix(W)[back][:, back].toarray(), q[back]
+        refined = cones.polish(G, lawbench_q, mu, dim - 1, P[back], True)
+        if refined is not None:
+            refined = refined[local_order(m, dim - 1)]
+            refined_error = fc3d_error(W, q, mu, refined)
+            if refined_error <= error:
+                P, error, polished = refined, refined_error, True
     if error > tol:
         raise SolverFailure(
             f"Gauss-Seidel stationary after {result.sweeps} sweeps at FC3D error {error:.3g}, "
-            f"above the tolerance {tol:g}"
+            f"above the tolerance {tol:g}{_rank_note(W)}"
         )
     diagnostics = {
         "formulation": "NSGS, exact local solver" + (" (numba)" if COMPILED else ""),
@@ -424,6 +499,25 @@ def _gauss_seidel(
         "fc3d_error": error,
     }
     return P, diagnostics
+
+
+# The largest Delassus matrix whose rank a failure message states (an SVD, O(n^3)).
+RANK_NOTE_MAX = 2000
+
+
+def _rank_note(W: Any) -> str:
+    """``'; W has rank r of n'`` for a singular Delassus matrix small enough to decompose.
+
+    Gauss-Seidel's sweeps contract only where ``W`` is regular: on a singular one (more contact
+    directions than the bodies' coordinates, as in granular packings) they can settle away
+    from any solution, and the rank says so.
+    """
+    n = W.shape[0]
+    if n > RANK_NOTE_MAX:
+        return ""
+    values = np.linalg.svd(scipy.sparse.csr_matrix(W).toarray(), compute_uv=False)
+    rank = int((values > n * np.finfo(float).eps * values[0]).sum())
+    return f"; W is singular, rank {rank} of {n}" if rank < n else ""
 
 
 LAWS.register(Moreau())

@@ -20,6 +20,28 @@ pytest.importorskip("h5py")
 FCLIB = Path(__file__).parent / "data" / "fclib"
 # One law with two methods, one without a method that refuses frictional problems.
 LAWS = "moreau,newton"
+# The fixed point's cone QPs need a symmetric W: it refuses these files' (tests/data/fclib).
+ASYMMETRIC = {"Capsules-i125-1213.hdf5": "0.00134", "OneObject-i100000-499.hdf5": "8.06e-05"}
+# Gauss-Seidel settles away from any solution on this singular W, as Siconos' NSGS does.
+STALLS = "OneObject-i100000-499.hdf5"
+
+
+def solved_but_where_the_law_says_why(moreau):
+    """Every Moreau row solves its file to 1e-8, but the fixed point's on an asymmetric W and
+    Gauss-Seidel's on the singular W, each failure with its reason."""
+    for file, asymmetry in ASYMMETRIC.items():
+        row = moreau[(moreau["file"] == file) & (moreau["method"] == "fixed_point")]
+        assert list(row["status"]) == ["not applicable"]
+        assert f"asymmetry is {asymmetry}" in row["error"].iloc[0]
+    stalled = moreau[(moreau["file"] == STALLS) & (moreau["method"] == "nsgs")]
+    assert list(stalled["status"]) == ["solver failure"]
+    assert "W is singular, rank 49 of 72" in stalled["error"].iloc[0]
+    others = moreau[
+        ~moreau.index.isin(stalled.index)
+        & ~(moreau["file"].isin(list(ASYMMETRIC)) & (moreau["method"] == "fixed_point"))
+    ]
+    assert (others["status"] == "ok").all()
+    assert (others["fc3d_error"] <= 1e-8).all()
 
 
 @pytest.fixture
@@ -45,9 +67,9 @@ def test_one_row_per_file_law_and_method_and_a_profile_figure(folder, tmp_path, 
     for (law, method), rows in table.fillna({"method": ""}).groupby(["law", "method"]):
         assert (law, method) in pairs
         assert sorted(rows["file"]) == files
-    moreau = table[(table["law"] == "moreau") & (table["file"] != "damaged.hdf5")]
-    assert (moreau["status"] == "ok").all()
-    assert (moreau["fc3d_error"] <= 1e-8).all()
+    solved_but_where_the_law_says_why(
+        table[(table["law"] == "moreau") & (table["file"] != "damaged.hdf5")]
+    )
     newton = table[(table["law"] == "newton") & (table["file"] != "damaged.hdf5")]
     assert (newton["status"] == "not applicable").all()
     assert out.with_suffix(".png").stat().st_size > 0
@@ -62,7 +84,7 @@ def test_a_damaged_file_is_an_error_row_and_the_others_are_solved(folder, tmp_pa
     damaged = table[table["file"] == "damaged.hdf5"]
     assert len(damaged) == 2 and (damaged["status"] == "error").all()
     assert damaged["error"].str.startswith("InvalidProblem").all()
-    assert (table[table["file"] != "damaged.hdf5"]["status"] == "ok").all()
+    solved_but_where_the_law_says_why(table[table["file"] != "damaged.hdf5"])
 
 
 @pytest.mark.parametrize("where", ["missing", "empty"])

@@ -1,4 +1,5 @@
-"""FCLIB files: read as impacts with e = 0, solved exactly by Moreau's law with Coulomb cones.
+"""FCLIB files: the global form read as an impact with e = 0, the local form as the
+contact-space problem it is, both solved exactly by Moreau's law with Coulomb cones.
 
 The reader is checked against files written here with h5py in FCLIB's own layout
 (``fclib.h``/``fclib.c`` of the FCLIB library: ``/fclib_local/W`` as a sparse matrix with
@@ -59,34 +60,33 @@ def random_local(rng, contacts):
     return W, q, rng.uniform(0.1, 1.0, contacts)
 
 
-def local_velocity_and_impulse(problem, outcome):
-    """u = W.T v+ and r = (Pn, Pt) in FCLIB's per-contact order (n, t1, t2)."""
-    m = problem.m
-    u_n, u_t = problem.Wn.T @ outcome.v_plus, problem.Wt.T @ outcome.v_plus
-    u = np.column_stack([u_n, u_t.reshape(m, 2)]).ravel()
-    r = np.column_stack([outcome.Pn, outcome.Pt.reshape(m, 2)]).ravel()
-    return u, r
+def assert_de_saxce(W, q, mu, r, tol):
+    """u = W r + q, r in the cones, u + (mu |u_T|, 0, 0) in the dual cones, complementarity."""
+    u = W @ r + q
+    scale = max(np.abs(q).max(), np.abs(r).max())
+    for j in range(mu.size):
+        un, ut, rn, rt = u[3 * j], u[3 * j + 1 : 3 * j + 3], r[3 * j], r[3 * j + 1 : 3 * j + 3]
+        assert np.linalg.norm(rt) <= mu[j] * rn + tol * scale
+        modified = un + mu[j] * np.linalg.norm(ut)
+        assert mu[j] * np.linalg.norm(ut) <= modified + tol * scale  # in the dual cone
+        assert abs(modified * rn + ut @ rt) <= tol * scale * scale
 
 
+@pytest.mark.parametrize("method", ["fixed_point", "nsgs"])
 @pytest.mark.parametrize("layout", ["triplet", "csc", "csr"])
 @pytest.mark.parametrize("contacts", [1, 3])
-def test_moreau_solves_the_fclib_local_problem(tmp_path, layout, contacts):
-    """u = W r + q, r in the cones, De Saxce's complementarity (Acary et al., FCLIB, 2014)."""
+def test_moreau_solves_the_fclib_local_problem(tmp_path, layout, contacts, method):
+    """u = W r + q, r in the cones, De Saxce's complementarity (Acary et al., FCLIB, 2014),
+    checked here on the W, q and mu written, not on what the reader returned."""
     W, q, mu = random_local(np.random.default_rng(contacts), contacts)
     path = tmp_path / "local.hdf5"
     fclib_local(path, W, q, mu, layout)
     problem = read_fclib(path)
-    assert [c.e for c in problem.contacts] == [0.0] * contacts
-    outcome = lawbench.solve("moreau", problem)
-    u, r = local_velocity_and_impulse(problem, outcome)
-    scale = np.abs(q).max()
-    assert np.abs(u - (W @ r + q)).max() <= 1e-9 * scale
-    for j in range(contacts):
-        un, ut, rn, rt = u[3 * j], u[3 * j + 1 : 3 * j + 3], r[3 * j], r[3 * j + 1 : 3 * j + 3]
-        assert np.linalg.norm(rt) <= mu[j] * rn + 1e-9 * np.abs(r).max()
-        modified = un + mu[j] * np.linalg.norm(ut)
-        assert mu[j] * np.linalg.norm(ut) <= modified + 1e-8 * scale  # in the dual cone
-        assert abs(modified * rn + ut @ rt) <= 1e-8 * scale * np.abs(r).max()
+    assert isinstance(problem, lawbench.ContactProblem)
+    solution = lawbench.LAWS["moreau"].solve_contact(problem, method=method)
+    assert_de_saxce(W, q, mu, solution.r, 1e-8)
+    assert solution.fc3d_error <= 1e-10
+    np.testing.assert_allclose(solution.u, W @ solution.r + q, rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("case", ["rocking_block", "sphere_wall", "bouncing_ball"])
@@ -94,8 +94,11 @@ def test_moreau_solves_the_fclib_local_problem(tmp_path, layout, contacts):
 def test_local_and_global_round_trips(tmp_path, case):
     problem = lawbench.CASES.get(case).build()
     local = read_fclib(write_fclib(problem, tmp_path / "local.h5", "local"))
-    assert np.allclose(local.W.T @ local.v, problem.W.T @ problem.v, rtol=1e-12, atol=1e-14)
-    assert np.allclose(local.contact_delassus, problem.contact_delassus, rtol=1e-10, atol=1e-12)
+    m, d = problem.m, problem.d
+    order = np.column_stack([np.arange(m), m + np.arange(m)[:, None] * d + np.arange(d)]).ravel()
+    np.testing.assert_allclose(local.q, (problem.W.T @ problem.v)[order], rtol=1e-12, atol=1e-14)
+    G = problem.contact_delassus[np.ix_(order, order)]
+    np.testing.assert_allclose(local.W.toarray(), G, rtol=1e-10, atol=1e-12)
     global_ = read_fclib(write_fclib(problem, tmp_path / "global.h5", "global"))
     assert np.array_equal(global_.M, problem.M) and np.array_equal(global_.W, problem.W)
     assert np.allclose(global_.v, problem.v, rtol=1e-13, atol=1e-15)
@@ -111,10 +114,10 @@ def test_local_and_global_round_trips(tmp_path, case):
     )
 
 
-def solved_from_the_command_line(folder, name):
+def solved_from_the_command_line(folder, name, *more):
     """The JSON record of ``lawbench solve moreau --problem NAME`` run in ``folder`` (exit 0)."""
     done = subprocess.run(
-        [sys.executable, "-m", "lawbench", "solve", "moreau", "--problem", name, "--json"],
+        [sys.executable, "-m", "lawbench", "solve", "moreau", "--problem", name, "--json", *more],
         capture_output=True,
         text=True,
         cwd=folder,
@@ -126,7 +129,9 @@ def solved_from_the_command_line(folder, name):
 def test_solve_an_fclib_file_from_the_command_line(tmp_path):
     W, q, mu = random_local(np.random.default_rng(5), 2)
     fclib_local(tmp_path / "p.hdf5", W, q, mu, "csc")
-    assert len(solved_from_the_command_line(tmp_path, "p.hdf5")["Pn"]) == 2
+    record = solved_from_the_command_line(tmp_path, "p.hdf5")
+    assert record["contacts"] == 2 and len(record["r"]) == len(record["u"]) == 6
+    assert_de_saxce(W, q, mu, np.array(record["r"]), 1e-8)
 
 
 def test_a_file_that_is_not_an_impact_problem_is_refused_by_name(tmp_path):
@@ -140,7 +145,9 @@ def test_a_file_that_is_not_an_impact_problem_is_refused_by_name(tmp_path):
 
 
 # Problems written by Siconos and LMGC90 (tests/data/fclib/README.md).
-FIELD = sorted((Path(__file__).parent / "data" / "fclib").glob("*.hdf5"))
+DATA = Path(__file__).parent / "data" / "fclib"
+FIELD = sorted(path for path in DATA.glob("*.hdf5") if "fclib_global" in h5py.File(path, "r"))
+LOCAL = sorted(path for path in DATA.glob("*.hdf5") if path not in FIELD)
 
 
 def coulomb_projection(x, mu):
@@ -193,25 +200,101 @@ def test_global_problems_from_siconos_and_lmgc90_are_solved_on_their_own_data(pa
     assert fclib_diagnostics(path, outcome)["fc3d_error"] <= 1e-8
 
 
-def test_the_fc3d_error_is_measured_on_the_files_own_asymmetric_w(tmp_path):
-    """A local file whose W is not symmetric is solved on W's symmetric part; the diagnostics
-    give the asymmetry and the FC3D error on the file's own W, which the symmetric answer
-    misses by the asymmetry's order (Siconos' fc3d_compute_error: 2-norm of the natural map
-    over max(|q|, |r|, |u|)). On the command line the JSON carries both."""
+# What each committed local file holds that a factorization W = Wc.T Wc, q = Wc.T v cannot.
+AS_GIVEN = {
+    "LMGC_100_PR_PerioBox-i00361-60-03000": ("q outside the range of W", 0.2, 0.0),
+    "Capsules-i125-1213": ("W asymmetric", 0.0, 1e-3),
+}
+SOLVED = [path for path in LOCAL if path.stem in AS_GIVEN]
+
+
+@pytest.mark.parametrize("path", SOLVED, ids=[p.stem for p in SOLVED])
+def test_local_problems_from_siconos_and_lmgc90_are_solved_as_given(path):
+    """The local files Siconos and LMGC90 wrote are solved on their own W and q, read here with
+    h5py in compressed rows (nz = -2), not with the reader under test: De Saxce's conditions
+    hold, and the FC3D error is at most 1e-8. The PerioBox file's q has a part outside the range
+    of W (27 % of |q|: W has rank 72 of 180), which no factorization W = Wc.T Wc with
+    q = Wc.T v can represent; the Capsules file's W is asymmetric by 1.3e-3, which the solve
+    reports and keeps."""
+    import scipy.sparse
+
+    with h5py.File(path, "r") as handle:
+        root = handle["fclib_local"]
+        group = root["W"]
+        shape = (int(group["m"][()].ravel()[0]), int(group["n"][()].ravel()[0]))
+        assert int(group["nz"][()].ravel()[0]) == -2
+        W = scipy.sparse.csr_matrix((group["x"][()], group["i"][()], group["p"][()]), shape=shape)
+        q = np.asarray(root["vectors"]["q"][()], dtype=float).ravel()
+        mu = np.asarray(root["vectors"]["mu"][()], dtype=float).ravel()
+    values, vectors = np.linalg.eigh(((W + W.T) / 2).toarray())
+    outside = q - vectors[:, values > 1e-12 * values.max()] @ (
+        vectors[:, values > 1e-12 * values.max()].T @ q
+    )
+    solution = lawbench.LAWS["moreau"].solve_contact(read_fclib(path), method="nsgs", tol=1e-8)
+    assert solution.fc3d_error <= 1e-8
+    assert_de_saxce(W, q, mu, solution.r, 1e-6)
+    asymmetry = abs(W - W.T).max() / abs(W).max()
+    assert solution.diagnostics["W_asymmetry"] == pytest.approx(asymmetry)
+    _, least_outside, least_asymmetry = AS_GIVEN[path.stem]
+    assert np.linalg.norm(outside) >= least_outside * np.linalg.norm(q)
+    assert asymmetry >= least_asymmetry
+
+
+def test_a_global_file_held_sparse_gives_the_dense_answer(monkeypatch):
+    """Global files whose matrices are large are held sparse (Siconos' Spheres file has a
+    12000 x 12000 M): read so, the Box_Stacks file gives the impulses of its dense reading to
+    rounding, with NSGS on the sparse Delassus matrix."""
+    from lawbench.files import fclib
+
+    path = next(p for p in FIELD if p.stem.startswith("Box_Stacks"))
+    dense = read_fclib(path)
+    monkeypatch.setattr(fclib, "DENSE_ENTRIES", 100)
+    sparse = read_fclib(path)
+    assert sparse.sparse and not dense.sparse
+    moreau = lawbench.LAWS["moreau"]
+    held_sparse = moreau.resolve(sparse, method="nsgs", tol=1e-10)
+    held_dense = moreau.resolve(dense, method="nsgs", tol=1e-10)
+    scale = np.abs(held_dense.Pn).max()
+    np.testing.assert_allclose(held_sparse.Pn, held_dense.Pn, rtol=0, atol=1e-8 * scale)
+    assert fclib_diagnostics(path, held_sparse)["fc3d_error"] <= 1e-10
+
+
+def test_an_asymmetric_w_is_solved_as_given_and_its_asymmetry_reported(tmp_path):
+    """A local file whose W is not symmetric is solved on the file's own W: NSGS sweeps W as
+    given to an FC3D error of 1e-10 (Siconos' fc3d_compute_error: 2-norm of the natural map
+    over max(|q|, |r|, |u|)), and the diagnostics give the asymmetry. The fixed point's cone QPs
+    need a symmetric matrix: it refuses a W asymmetric beyond its tolerance, naming the
+    asymmetry. On the command line the JSON carries both."""
     W, q, mu = random_local(np.random.default_rng(11), 3)
     skew = np.triu(np.full_like(W, 1e-4), 1)
-    fclib_local(tmp_path / "sym.hdf5", W, q, mu, "csc")
     fclib_local(tmp_path / "asym.hdf5", W + skew - skew.T, q, mu, "csc")
-    symmetric = fclib_diagnostics(
-        tmp_path / "sym.hdf5", lawbench.solve("moreau", read_fclib(tmp_path / "sym.hdf5"))
+    problem = read_fclib(tmp_path / "asym.hdf5")
+    moreau = lawbench.LAWS["moreau"]
+    solution = moreau.solve_contact(problem, method="nsgs")
+    assert solution.diagnostics["W_asymmetry"] == pytest.approx(
+        2e-4 / np.abs(W + skew - skew.T).max()
     )
-    assert symmetric["W_asymmetry"] == 0.0 and symmetric["fc3d_error"] <= 1e-10
-    outcome = lawbench.solve("moreau", read_fclib(tmp_path / "asym.hdf5"))
-    found = fclib_diagnostics(tmp_path / "asym.hdf5", outcome)
-    assert found["W_asymmetry"] == pytest.approx(2e-4 / np.abs(W + skew - skew.T).max())
-    assert 1e-7 < found["fc3d_error"] < 1e-2
-    record = solved_from_the_command_line(tmp_path, "asym.hdf5")
-    assert record["diagnostics"]["fc3d_error"] == pytest.approx(found["fc3d_error"])
+    assert solution.fc3d_error <= 1e-10
+    assert_de_saxce(W + skew - skew.T, q, mu, solution.r, 1e-8)
+    with pytest.raises(lawbench.NotApplicable, match=r"asymmetry is 2\.\d+e-05"):
+        moreau.solve_contact(problem)
+    record = solved_from_the_command_line(tmp_path, "asym.hdf5", "--option", "method=nsgs")
+    assert record["fc3d_error"] == pytest.approx(solution.fc3d_error, abs=1e-13)
+    assert record["diagnostics"]["W_asymmetry"] == solution.diagnostics["W_asymmetry"]
+
+
+def test_a_law_without_a_contact_space_solver_refuses_a_local_problem(tmp_path, capsys):
+    """Only a law that solves Coulomb's problem in contact space takes FCLIB's local form;
+    the others say why (exit 3 on the command line)."""
+    from lawbench.views import cli
+
+    W, q, mu = random_local(np.random.default_rng(4), 2)
+    fclib_local(tmp_path / "p.hdf5", W, q, mu, "csc")
+    problem = read_fclib(tmp_path / "p.hdf5")
+    with pytest.raises(lawbench.NotApplicable, match="generalized coordinates"):
+        lawbench.LAWS["whittaker"].solve_contact(problem)
+    assert cli.main(["solve", "newton", "--problem", str(tmp_path / "p.hdf5")]) == 3
+    assert "contact-space problem" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(
@@ -277,14 +360,14 @@ def test_exporting_a_restitution_warns_that_fclib_holds_none(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("key", "value", "message"),
     [
-        ("m", 10**8, "more than the 5e\\+07 entries"),
+        ("m", 10**8, r"W is 100000000 x 6 .* need 6 x 6"),
         ("m", 7, r"W is 7 x 6 .* need 6 x 6"),
         ("x", np.array([b"a"] * 6), "not numbers"),
     ],
 )
 def test_a_matrix_too_large_to_hold_or_not_numeric_is_refused(tmp_path, key, value, message):
-    """A declared shape is bounded before anything is allocated, W is square with one row per
-    contact coordinate, and its entries are numbers."""
+    """W is held sparse whatever its declared shape, is square with one row per contact
+    coordinate, and its entries are numbers."""
     W, q, mu = random_local(np.random.default_rng(2), 2)
     path = tmp_path / "p.hdf5"
     fclib_local(path, W, q, mu, "csc")
@@ -317,6 +400,5 @@ def test_siconos_reads_and_solves_what_lawbench_writes(tmp_path, case):
     options = sn.SolverOptions(sn.SICONOS_FRICTION_3D_NSGS)
     options.iparam[0], options.dparam[0] = 10_000, 1e-12
     assert sn.fc3d_nsgs(siconos_problem, r, u, options) == 0
-    outcome = lawbench.solve("moreau", read_fclib(local))
-    ours = np.column_stack([outcome.Pn, outcome.Pt.reshape(problem.m, 2)]).ravel()
+    ours = lawbench.LAWS["moreau"].solve_contact(read_fclib(local)).r
     np.testing.assert_allclose(r, ours, atol=1e-8)

@@ -7,6 +7,12 @@ checks the options and the problem against the tags, restricts the problem to it
 units near it and scales the answer back (`ImpactProblem.units`), times the solve within the
 budget its options set (`lawbench.core.budget`: every law has ``max_seconds``), and refuses to
 return a non-finite answer.
+
+A law that also solves Coulomb's frictional contact problem in contact space (FCLIB's local
+form, `lawbench.core.contact.ContactProblem`: no generalized coordinates, only ``W``, ``q`` and
+``mu``) implements `Law._solve_contact`; `Law.solve_contact` gives it the same checked options,
+budget, timing and refusal of non-finite answers. The other laws refuse such a problem with
+`NotApplicable`.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from lawbench.core import budget
+from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem, all_finite
@@ -192,6 +199,65 @@ class Law(ABC):
     @abstractmethod
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         """Resolve a problem whose contacts are all closed."""
+
+    @property
+    def solves_contact_problems(self) -> bool:
+        """Whether the law solves a `ContactProblem` (it implements `_solve_contact`)."""
+        return type(self)._solve_contact is not Law._solve_contact
+
+    def solve_contact(self, problem: ContactProblem, **options: Any) -> ContactSolution:
+        """Solve Coulomb's frictional contact problem ``problem`` in contact space.
+
+        Parameters
+        ----------
+        problem : ContactProblem
+            ``u = W r + q`` with De Saxce's complementarity per contact, ``W`` as given.
+        **options
+            The law's options (see ``options``).
+
+        Returns
+        -------
+        ContactSolution
+            The impulses, local velocities and FC3D error on the problem's own ``W`` and
+            ``q``; diagnostics with ``wall_time_s``, ``options``, ``W_asymmetry`` and
+            ``warnings`` where the solve raised any.
+
+        Raises
+        ------
+        InvalidProblem
+            For a bad option.
+        NotApplicable
+            When the law solves impacts in generalized coordinates only, or cannot treat this
+            problem.
+        SolverFailure
+            When the numerical method fails or would return a non-finite number.
+        """
+        if not isinstance(problem, ContactProblem):
+            raise TypeError(f"problem must be a ContactProblem, not {type(problem).__name__}")
+        values = self.option_values(options)
+        if not self.solves_contact_problems:
+            raise NotApplicable(
+                f"{self.name}: resolves impacts in generalized coordinates; a contact-space "
+                "problem (FCLIB's local form: W, q and mu only) has none"
+            )
+        start = time.perf_counter()
+        with budget.Budget.of(self.name, values), warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            r, diagnostics = self._solve_contact(problem, values)
+        wall_time = time.perf_counter() - start
+        if not all_finite(r):
+            raise SolverFailure(f"{self.name}: non-finite impulses {r}")
+        heard = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
+        diagnostics.update(options=values, wall_time_s=wall_time, W_asymmetry=problem.asymmetry)
+        if heard:
+            diagnostics["warnings"] = heard
+        return ContactSolution(r, problem.velocity(r), problem.error(r), diagnostics)
+
+    def _solve_contact(
+        self, problem: ContactProblem, options: dict[str, Any]
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """The impulses (FCLIB's order) and diagnostics of a contact-space problem."""
+        raise NotApplicable(f"{self.name}: solves no contact-space problem")
 
     def resolve_batch(self, batch: ProblemBatch, **options: Any) -> OutcomeBatch:
         """Resolve every problem of ``batch``: vectorized where the law can, else one by one.

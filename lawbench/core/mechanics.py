@@ -109,6 +109,23 @@ def project(Pn: float, Pt: np.ndarray, mu: float) -> tuple[float, np.ndarray]:
     return normal, mu * normal * Pt / norm
 
 
+def project_all(x: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """`project` of every row ``(Pn, Pt...)`` of ``x`` (m, 1 + d) on its cone, at once."""
+    normal, tangent = x[:, 0], x[:, 1:]
+    norm = np.linalg.norm(tangent, axis=1)
+    inside = (norm <= mu * normal) & (normal >= 0)
+    polar = mu * norm <= -normal
+    projected_normal = (normal + mu * norm) / (1.0 + mu * mu)
+    found = np.empty_like(x)
+    found[:, 0] = np.where(inside, normal, np.where(polar, 0.0, projected_normal))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        along = np.where(norm > 0, mu * projected_normal / norm, 0.0)
+    found[:, 1:] = np.where(
+        inside[:, None], tangent, np.where(polar[:, None], 0.0, along[:, None] * tangent)
+    )
+    return found
+
+
 def fc3d_error(W: np.ndarray, q: np.ndarray, mu: np.ndarray, r: np.ndarray) -> float:
     """The FC3D error of a local frictional contact answer ``r`` (Acary, Brémond, Huber 2018).
 
@@ -123,10 +140,6 @@ def fc3d_error(W: np.ndarray, q: np.ndarray, mu: np.ndarray, r: np.ndarray) -> f
     rj = r.reshape(-1, dim)
     x = rj - u
     x[:, 0] -= mu * np.linalg.norm(u[:, 1:], axis=1)
-    gap = np.empty_like(rj)
-    for j, (xj, mj) in enumerate(zip(x, mu, strict=True)):
-        normal, tangent = project(float(xj[0]), xj[1:], float(mj))
-        gap[j, 0], gap[j, 1:] = rj[j, 0] - normal, rj[j, 1:] - tangent
-    error = float(np.linalg.norm(gap))
+    error = float(np.linalg.norm(rj - project_all(x, mu)))
     scale = max(float(np.linalg.norm(q)), float(np.linalg.norm(r)), float(np.linalg.norm(u)))
     return error / scale if scale > np.finfo(float).eps else error

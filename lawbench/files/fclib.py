@@ -11,16 +11,14 @@ has one entry per contact; ``spacedim`` is 3 (or 2).
 - Global form ``/fclib_global``: ``M v = H r + f``, ``u = H.T v + w`` and the same cone
   complementarity (``G``, ``b``: equality constraints, not read here).
 
-As an impact with ``e = 0`` this is exactly Moreau's law with Coulomb cones: the impulses are
-``r``, the post-impact local velocities ``u``. The global form maps to ``M``, ``W = H``
-(normal columns ``Wn``, tangential ``Wt``) and the pre-impact velocity ``v- = M^-1 f``; an
-offset ``w`` has no counterpart in an impact problem and is refused. The local form has no
-generalized coordinates: they are built from the eigendecomposition ``W = V diag(l) V.T``,
-keeping the ``k`` positive eigenvalues, with ``M = I_k``, contact Jacobian
-``Wc = diag(sqrt(l)) V.T`` (so ``Wc.T Wc = W``, singular ``W`` included) and ``v- = Wc^+ q``;
-a ``q`` outside the range of ``W`` is refused. A Delassus matrix is symmetric: the factorization
-takes ``W``'s symmetric part, and `fclib_diagnostics` gives the file's asymmetry and the FC3D
-error of an answer on the file's own ``W`` and ``q``, the measure of the field's comparisons.
+The global form is exactly an impact with ``e = 0`` resolved by Moreau's law with Coulomb
+cones: `read_fclib` maps it to an `ImpactProblem` with ``M``, ``W = H`` (normal columns
+``Wn``, tangential ``Wt``) and the pre-impact velocity ``v- = M^-1 f``; an offset ``w`` has no
+counterpart in an impact problem and is refused. The local form has no generalized
+coordinates: it is read as the `ContactProblem` it is, ``W`` and ``q`` as given (an asymmetric
+``W`` is kept, and its asymmetry reported by the solve; ``q`` need not lie in the range of
+``W``). `fclib_diagnostics` gives the FC3D error of a global problem's answer on the file's own
+data, the measure of the field's comparisons; a contact-space solve reports it itself.
 
 Matrices are read in any of FCLIB's sparse layouts (``nz = -1`` compressed columns, ``-2``
 compressed rows, ``>= 0`` triplets: row ``i[k]``, column ``p[k]``), their index arrays checked
@@ -38,17 +36,20 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse
+import scipy.sparse.linalg
 
+from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, LawbenchError, LossyExport, NotApplicable
 from lawbench.core.mechanics import fc3d_error
 from lawbench.core.outcome import Outcome
-from lawbench.core.problem import ImpactProblem
+from lawbench.core.problem import ImpactProblem, as_array
 from lawbench.files.hdf5 import require_h5py
 from lawbench.files.paths import input_file, output_file
 
 FORMS = ("local", "global")
-# The largest matrix read (entries, held dense): 400 MB of doubles, far above the field's problems.
-MAX_ENTRIES = 50_000_000
+# The largest matrix of a global form held dense (entries, 8 MB of doubles); larger ones are
+# held sparse, as a local form's W always is.
+DENSE_ENTRIES = 1_000_000
 # FCLIB files are HDF5: an extension that names another encoding would mislead every reader.
 SUFFIXES = (".h5", ".hdf5")
 # FCLIB's forms that are not frictional impacts, by their HDF5 group: recognised, and refused.
@@ -65,8 +66,8 @@ def is_fclib(path: str | Path) -> bool:
         return False
 
 
-def _read_matrix(group: Any, where: str) -> np.ndarray:
-    """A matrix in any of FCLIB's layouts, its index arrays checked against its shape first.
+def _read_matrix(group: Any, where: str) -> scipy.sparse.csr_matrix:
+    """A sparse matrix in any of FCLIB's layouts, index arrays checked against its shape first.
 
     Triplets (``nz >= 0``) hold the row of entry k in ``i[k]`` and its column in ``p[k]``:
     CSparse's triplets, which Siconos and LMGC90 write (the field comments of ``fclib.h`` name
@@ -82,10 +83,6 @@ def _read_matrix(group: Any, where: str) -> np.ndarray:
     m, n, nz = number("m"), number("n"), number("nz")
     if m < 0 or n < 0:
         raise InvalidProblem(f"{where}: a matrix of {m} x {n}")
-    if m * n > MAX_ENTRIES:
-        raise InvalidProblem(
-            f"{where}: a matrix of {m} x {n}, more than the {MAX_ENTRIES:.0e} entries read at most"
-        )
     p, i, x = (_array(group, key, where) for key in ("p", "i", "x"))
     for key, index in (("p", p), ("i", i)):
         if not np.issubdtype(index.dtype, np.integer):
@@ -101,7 +98,7 @@ def _read_matrix(group: Any, where: str) -> np.ndarray:
         rows, columns = i[:nz], p[:nz]
         _within(rows, m, f"{where}/i (rows)")
         _within(columns, n, f"{where}/p (columns)")
-        return scipy.sparse.coo_matrix((x[:nz], (rows, columns)), shape=(m, n)).toarray()
+        return scipy.sparse.coo_matrix((x[:nz], (rows, columns)), shape=(m, n)).tocsr()
     if nz not in (-1, -2):
         raise InvalidProblem(f"{where}/nz = {nz}: not an FCLIB sparse layout (-2, -1 or >= 0)")
     major, minor, layout = (n, m, "columns") if nz == -1 else (m, n, "rows")
@@ -118,7 +115,7 @@ def _read_matrix(group: Any, where: str) -> np.ndarray:
     _within(i[: p[-1]], minor, f"{where}/i")
     arrays = (x[: p[-1]], i[: p[-1]], p)
     matrix = scipy.sparse.csc_matrix if nz == -1 else scipy.sparse.csr_matrix
-    return matrix(arrays, shape=(m, n)).toarray()
+    return scipy.sparse.csr_matrix(matrix(arrays, shape=(m, n)))
 
 
 def _array(group: Any, key: str, where: str) -> np.ndarray:
@@ -160,15 +157,14 @@ def _vector(group: Any, key: str, where: str) -> np.ndarray:
     return np.asarray(group[key][()], dtype=float).ravel()
 
 
-def _split(W: np.ndarray, dim: int, mu: np.ndarray, where: str) -> dict[str, Any]:
+def _split(W: Any, dim: int, mu: np.ndarray, where: str) -> dict[str, Any]:
     """Normal and tangential columns from FCLIB's per-contact (n, t1[, t2]) order."""
     if W.shape[1] % dim or W.shape[1] // dim != mu.size:
         raise InvalidProblem(
             f"{where}: {W.shape[1]} local coordinates for {mu.size} contacts of dimension {dim}"
         )
-    Wn = W[:, 0::dim]
-    Wt = np.stack([W[:, k::dim] for k in range(1, dim)], axis=2).reshape(W.shape[0], -1)
-    return {"Wn": Wn, "Wt": Wt}
+    first = np.arange(mu.size)[:, None] * dim
+    return {"Wn": W[:, first[:, 0]], "Wt": W[:, (first + np.arange(1, dim)).ravel()]}
 
 
 def _local_order(problem: ImpactProblem) -> np.ndarray:
@@ -215,46 +211,49 @@ def _opened(path: str | Path) -> Iterator[tuple[Any, str, str, int]]:
             raise InvalidProblem(f"{where}: a damaged HDF5 file ({exc})") from None
 
 
-def read_fclib(path: str | Path) -> ImpactProblem:
-    """Read an FCLIB file (local or global form) as an impact problem with ``e = 0``.
+def read_fclib(path: str | Path) -> ImpactProblem | ContactProblem:
+    """Read an FCLIB file: the global form as an impact, the local form as given.
+
+    The global form is an `ImpactProblem` with ``e = 0``; the local form a `ContactProblem`
+    with ``W`` and ``q`` as the file holds them.
 
     Raises
     ------
     InvalidProblem
         For a file that is not FCLIB, a missing field, a form this mapping cannot represent
-        (equality constraints, an offset ``w``, ``q`` outside the range of ``W``), or a bad
-        field of the resulting problem; the message names the field.
+        (equality constraints, an offset ``w``, a mixed local problem), or a bad field of the
+        resulting problem; the message names the field.
     NotApplicable
         For FCLIB's rolling-friction form: no impact law here has rolling resistance.
     """
     with _opened(path) as (root, form, where, dim):
         vectors = root["vectors"]
         mu = _vector(vectors, "mu", f"{where}/vectors")
-        if form == "global":
-            if "G" in root:
-                raise InvalidProblem(f"{where}/G: equality constraints are not an impact problem")
-            M = _read_matrix(root["M"], f"{where}/M")
-            H = _read_matrix(root["H"], f"{where}/H")
-            f = _vector(vectors, "f", f"{where}/vectors")
-            w = _vector(vectors, "w", f"{where}/vectors")
-            if np.any(w):
-                raise InvalidProblem(
-                    f"{where}/vectors/w: a constant local velocity has no impact counterpart"
-                )
-            columns, v = H, _solve(M, f, where)
-        else:
+        if form == "local":
             if "V" in root or "R" in root:
                 raise InvalidProblem(f"{where}/V, R: mixed problems are not an impact problem")
             W, q = _local(root, mu.size * dim, where)
-            M, columns, v = _coordinates(W, q, where)
+            return ContactProblem(W, q, mu, dim, name=where)
+        if "G" in root:
+            raise InvalidProblem(f"{where}/G: equality constraints are not an impact problem")
+        M = _held(_read_matrix(root["M"], f"{where}/M"))
+        H = _held(_read_matrix(root["H"], f"{where}/H"))
+        f = _vector(vectors, "f", f"{where}/vectors")
+        w = _vector(vectors, "w", f"{where}/vectors")
+        if np.any(w):
+            raise InvalidProblem(
+                f"{where}/vectors/w: a constant local velocity has no impact counterpart"
+            )
     try:
-        return ImpactProblem.from_arrays(M, v=v, **_split(columns, dim, mu, where), e=0.0, mu=mu)
+        return ImpactProblem.from_arrays(
+            M, v=_solve(M, f, where), **_split(H, dim, mu, where), e=0.0, mu=mu
+        )
     except InvalidProblem as exc:
         raise InvalidProblem(f"{where}: {exc}") from None
 
 
-def _local(root: Any, size: int, where: str) -> tuple[np.ndarray, np.ndarray]:
-    """The local form's ``W`` and ``q``, checked to be ``size`` x ``size`` and ``size`` long."""
+def _local(root: Any, size: int, where: str) -> tuple[Any, np.ndarray]:
+    """The local form's ``W`` (sparse) and ``q``, checked to be ``size`` square and long."""
     W = _read_matrix(root["W"], f"{where}/W")
     q = _vector(root["vectors"], "q", f"{where}/vectors")
     if W.shape != (size, size) or q.size != size:
@@ -265,56 +264,49 @@ def _local(root: Any, size: int, where: str) -> tuple[np.ndarray, np.ndarray]:
     return W, q
 
 
-def _solve(M: np.ndarray, f: np.ndarray, where: str) -> np.ndarray:
+def _solve(M: Any, rhs: np.ndarray, where: str) -> np.ndarray:
+    """``M^-1 rhs`` for a dense or sparse ``M``."""
     try:
-        return np.linalg.solve(M, f)
-    except np.linalg.LinAlgError:
+        if scipy.sparse.issparse(M):
+            return scipy.sparse.linalg.splu(scipy.sparse.csc_matrix(M)).solve(rhs)
+        return np.linalg.solve(M, rhs)
+    except (np.linalg.LinAlgError, RuntimeError):  # RuntimeError: splu's singular pivot
         raise InvalidProblem(f"{where}/M is singular") from None
 
 
-def _coordinates(W: np.ndarray, q: np.ndarray, where: str) -> tuple[np.ndarray, ...]:
-    """``M = I``, ``Wc`` with ``Wc.T Wc = W`` and ``v`` with ``Wc.T v = q``, from W's spectrum."""
-    W = (W + W.T) / 2
-    values, vectors = np.linalg.eigh(W)
-    keep = values > 1e-12 * max(values.max(), 0.0)
-    if not keep.any():
-        raise InvalidProblem(f"{where}/W has no positive eigenvalue")
-    Wc = np.sqrt(values[keep])[:, None] * vectors[:, keep].T
-    v, *_ = np.linalg.lstsq(Wc.T, q, rcond=None)
-    if np.abs(Wc.T @ v - q).max() > 1e-9 * max(np.abs(q).max(), 1e-300):
-        raise InvalidProblem(f"{where}/vectors/q lies outside the range of W")
-    return np.eye(int(keep.sum())), Wc, v
+def _held(matrix: scipy.sparse.csr_matrix) -> Any:
+    """A global form's matrix as its impact problem holds it.
+
+    Dense up to `DENSE_ENTRIES` entries, sparse (compressed columns) beyond.
+    """
+    m, n = matrix.shape
+    return matrix.toarray() if m * n <= DENSE_ENTRIES else scipy.sparse.csc_array(matrix)
 
 
 def fclib_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
-    """How ``outcome`` answers the FCLIB problem of ``path``, on the file's own data.
+    """How ``outcome`` answers the global FCLIB problem of ``path``, on the file's own data.
 
     ``fc3d_error``: Acary, Brémond and Huber's measure (`lawbench.core.mechanics.fc3d_error`)
-    on the file's ``W`` and ``q`` (global form: ``W = H.T M^-1 H``, ``q = H.T M^-1 f + w``),
-    with ``r`` the outcome's impulses in the file's local order. For the local form also
-    ``W_asymmetry``, ``max |W - W.T| / max |W|``: the impact problem read from the file keeps
-    ``W``'s symmetric part, so an answer exact on it is off by that order on the file's ``W``.
+    on ``W = H.T M^-1 H`` and ``q = H.T M^-1 f + w`` of the file, with ``r`` the outcome's
+    impulses in the file's local order. A local file is solved as the `ContactProblem` it is,
+    whose solution carries that error itself: nothing is added for it.
     """
     with _opened(path) as (root, form, where, dim):
+        if form == "local":
+            return {}
         vectors = root["vectors"]
         mu = _vector(vectors, "mu", f"{where}/vectors")
-        if form == "local":
-            W, q = _local(root, mu.size * dim, where)
-        else:
-            M = _read_matrix(root["M"], f"{where}/M")
-            H = _read_matrix(root["H"], f"{where}/H")
-            W = H.T @ _solve(M, H, where)
-            q = H.T @ _solve(M, _vector(vectors, "f", f"{where}/vectors"), where)
-            q = q + _vector(vectors, "w", f"{where}/vectors")
+        M = _held(_read_matrix(root["M"], f"{where}/M"))
+        H = _held(_read_matrix(root["H"], f"{where}/H"))
+        W = H.T @ _solve(M, as_array(H), where)
+        q = H.T @ _solve(M, _vector(vectors, "f", f"{where}/vectors"), where)
+        q = q + _vector(vectors, "w", f"{where}/vectors")
     m = mu.size
     r = np.zeros((m, dim))
     r[:, 0] = outcome.Pn
     if outcome.Pt.size:
         r[:, 1:] = outcome.Pt.reshape(m, dim - 1)
-    found = {"fc3d_error": fc3d_error(W, q, mu, r.ravel())}
-    if form == "local":
-        found["W_asymmetry"] = float(np.abs(W - W.T).max() / max(np.abs(W).max(), 1e-300))
-    return found
+    return {"fc3d_error": fc3d_error(W, q, mu, r.ravel())}
 
 
 def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -> Path:

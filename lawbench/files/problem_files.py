@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse
 
+from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import Contact, ImpactProblem, is_sparse
@@ -139,10 +140,11 @@ def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
     return path
 
 
-def load_problem(path: str | Path) -> ImpactProblem:
+def load_problem(path: str | Path) -> ImpactProblem | ContactProblem:
     """Read a problem written by `save_problem` (or by hand, in the same format).
 
-    An HDF5 file holding an FCLIB problem is read as one (`lawbench.files.fclib.read_fclib`).
+    An HDF5 file holding an FCLIB problem is read as one (`lawbench.files.fclib.read_fclib`):
+    its global form as an `ImpactProblem`, its local form as the `ContactProblem` it is.
 
     Raises
     ------
@@ -181,8 +183,9 @@ def load_problem(path: str | Path) -> ImpactProblem:
 def file_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
     """What a problem file's own data says of ``outcome``.
 
-    For an FCLIB file its FC3D error (`lawbench.files.fclib.fclib_diagnostics`); nothing for
-    lawbench's own formats, which hold the problem exactly as it is solved.
+    For a global FCLIB file its FC3D error (`lawbench.files.fclib.fclib_diagnostics`); nothing
+    for lawbench's own formats, which hold the problem exactly as it is solved, nor for a local
+    FCLIB file, whose contact-space solution carries that error itself.
     """
     path = Path(path)
     if _codec(path)[1] is _read_hdf5:

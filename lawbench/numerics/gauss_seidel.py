@@ -1,15 +1,17 @@
 """Coulomb's law in the impulses by nonsmooth Gauss-Seidel, each contact solved exactly.
 
-The problem is the one of `lawbench.numerics.cones`: find ``P`` with, per contact j,
-``K_j ∋ P_j _|_ uhat_j ∈ K*_j``, ``u = G P + q``, ``uhat_j = (un_j + mu_j |ut_j|, ut_j)``,
-``K_j = {|Pt_j| <= mu_j Pn_j}`` (De Saxce and Feng 1991); ``G`` and ``q`` in lawbench's order
-(the m normal components, then contact j's tangential ones at ``m + j*d ... m + j*d + d - 1``).
+The problem is FCLIB's local form (`lawbench.core.contact`): find ``P`` with, per contact j,
+``K_j ∋ P_j _|_ uhat_j ∈ K*_j``, ``u = W P + q``, ``uhat_j = (un_j + mu_j |ut_j|, ut_j)``,
+``K_j = {|Pt_j| <= mu_j Pn_j}`` (De Saxce and Feng 1991); ``W`` and ``q`` in FCLIB's order (per
+contact its normal, then its ``dim - 1`` tangents), ``W`` as given, symmetric or not.
+`in_local_order` brings a Delassus matrix of lawbench's order (the m normal components, then
+contact j's tangential ones at ``m + j*d ... m + j*d + d - 1``) to it.
 
 Nonsmooth Gauss-Seidel (Jean, CMAME 177, 1999; Acary, Brémond and Huber, "On solving contact
 problems with Coulomb friction: formulations and numerical comparisons", 2018, section 4.1;
 Siconos' ``fc3d_nsgs``) sweeps the contacts in order; contact j's local problem, the others
-fixed, is ``u_j = W P_j + b`` with ``W = G_jj`` (its diagonal block) and ``b`` the rest of
-``(G P + q)_j``, and is solved exactly (`solve_contact`) by trying its three states in turn:
+fixed, is ``u_j = W_jj P_j + b`` with ``W_jj`` its diagonal block and ``b`` the rest of
+``(W P + q)_j``, and is solved exactly (`solve_contact`) by trying its three states in turn:
 
 - take-off: ``P_j = 0``, the solution exactly when ``b_n >= 0``;
 - stick: ``W P_j = -b``, the solution when it lies in the cone;
@@ -26,7 +28,10 @@ problem none of whose states qualifies (a singular block, or rounding at a state
 solved by Siconos' fallback, the projection iteration
 ``P_j <- proj_K(P_j - (u_j + (mu_j |ut_j|, 0)) / W_nn)`` (Acary et al. 2018, eq. 4.4).
 
-Sweeps go on until the FC3D error (`lawbench.core.mechanics.fc3d_error`) is at most ``tol``. It
+Sweeps go on until the FC3D error (`lawbench.core.mechanics.fc3d_error`) is at most ``tol``, or
+until the iteration is stationary: a sweep leaves ``P`` unchanged, or the error has not fallen
+by a millionth over a thousand sweeps (on a singular Delassus matrix Gauss-Seidel can settle on a
+point that is no solution, as Siconos' NSGS does on the same problems). The error
 costs about as much as a sweep, so, like Siconos' light-then-full evaluation, it is computed
 when the relative change of ``P`` over a sweep falls below a gate (``tol`` at first, lowered by
 the ratio of the error found to ``tol``), and every `CHECK_EVERY` sweeps. Each sweep spends one
@@ -35,7 +40,7 @@ or ``max_seconds``.
 
 The per-contact kernel and the sweep are compiled by numba when it is installed
 (``pip install 'lawbench[fast]'``); the same functions run as plain Python without it.
-``G`` may be dense or scipy.sparse: it is held in compressed rows, so a sweep costs time
+``W`` may be dense or scipy.sparse: it is held in compressed rows, so a sweep costs time
 proportional to its non-zero entries.
 """
 
@@ -75,6 +80,9 @@ SINGULAR = 1e12
 ANGLE_STEPS, ALIGNED = 50, 1e-8
 # Sweeps between two evaluations of the FC3D error while the change of P stays above the gate.
 CHECK_EVERY = 10
+# The iteration is stationary when its FC3D error has not fallen by a fraction STALL_DROP over
+# STALL_SWEEPS sweeps: at that pace reaching a tolerance would take millions of sweeps.
+STALL_DROP, STALL_SWEEPS = 1e-6, 1000
 # Projection steps of the fallback local solver.
 FALLBACK_STEPS = 200
 TINY = np.finfo(float).tiny
@@ -97,11 +105,16 @@ def local_order(m: int, d: int) -> np.ndarray:
     return np.column_stack([np.arange(m), tangential]).ravel()
 
 
+def in_local_order(G: Any, q: np.ndarray, m: int, d: int) -> tuple[Any, np.ndarray]:
+    """``G`` (CSR) and ``q`` of lawbench's order (normals, then tangents) in FCLIB's order."""
+    order = local_order(m, d)
+    return scipy.sparse.csr_matrix(G)[order][:, order], np.asarray(q, dtype=float)[order]
+
+
 def error_of(G: Any, q: np.ndarray, mu: np.ndarray, d: int, P: np.ndarray) -> float:
     """The FC3D error of ``P`` (lawbench's order) on ``G``, ``q`` (dense or sparse ``G``)."""
-    order = local_order(len(mu), d)
-    W = scipy.sparse.csr_matrix(G)[order][:, order]
-    return fc3d_error(W, q[order], mu, P[order])
+    W, local_q = in_local_order(G, q, len(mu), d)
+    return fc3d_error(W, local_q, mu, P[local_order(len(mu), d)])
 
 
 @_compiled
@@ -119,9 +132,10 @@ def _refined(A: np.ndarray, B: np.ndarray, C: np.ndarray, angle: float) -> np.nd
     """The unit direction at the root of ``e x V(t)`` Newton's method reaches from ``angle``."""
     for _ in range(ANGLE_STEPS):
         c, s = np.cos(angle), np.sin(angle)
-        V, dV = A + B * c + C * s, C * c - B * s
-        h = c * V[1] - s * V[0]
-        slope = -s * V[1] - c * V[0] + c * dV[1] - s * dV[0]
+        V0, V1 = A[0] + B[0] * c + C[0] * s, A[1] + B[1] * c + C[1] * s
+        dV0, dV1 = C[0] * c - B[0] * s, C[1] * c - B[1] * s
+        h = c * V1 - s * V0
+        slope = -s * V1 - c * V0 + c * dV1 - s * dV0
         if slope == 0.0:
             break
         angle -= h / slope
@@ -166,16 +180,32 @@ def _slip_along(W: np.ndarray, b: np.ndarray, mu: float, e: np.ndarray) -> np.nd
 
     ``Pn = -b_n / (W_nn - mu W_nt e) > 0``, ``Pt = -mu Pn e``, and ``ut`` along ``+e``.
     """
-    denominator = W[0, 0] - mu * np.dot(W[0, 1:], e)
+    size = b.size
+    denominator = W[0, 0]
+    for k in range(1, size):
+        denominator -= mu * W[0, k] * e[k - 1]
     if denominator <= 0.0:
         return np.zeros(0)
-    P = np.empty(b.size)
+    P = np.empty(size)
     P[0] = -b[0] / denominator
-    P[1:] = -mu * P[0] * e
-    ut = W[1:] @ P + b[1:]
-    along = np.dot(ut, e)
-    across = np.linalg.norm(ut - along * e)
-    if along < 0.0 or across > ALIGNED * (np.linalg.norm(ut) + np.abs(b).max()):
+    for k in range(1, size):
+        P[k] = -mu * P[0] * e[k - 1]
+    ut = np.empty(size - 1)
+    for a in range(1, size):
+        total = b[a]
+        for c in range(size):
+            total += W[a, c] * P[c]
+        ut[a - 1] = total
+    along = 0.0
+    for k in range(size - 1):
+        along += ut[k] * e[k]
+    across = 0.0
+    for k in range(size - 1):
+        across += (ut[k] - along * e[k]) ** 2
+    largest = 0.0
+    for value in b:
+        largest = max(largest, abs(value))
+    if along < 0.0 or np.sqrt(across) > ALIGNED * (_norm(ut) + largest):
         return np.zeros(0)
     return P
 
@@ -259,10 +289,21 @@ def _in_a_state(
             P[0] = -b[0] / W[0, 0]
         return P
     if np.isfinite(inverse[0, 0]):
-        stick = -(inverse @ b)
-        if stick[0] > 0.0 and np.linalg.norm(stick[1:]) <= mu * stick[0]:
-            return stick
+        for a in range(b.size):
+            for c in range(b.size):
+                P[a] -= inverse[a, c] * b[c]
+        if P[0] > 0.0 and _norm(P[1:]) <= mu * P[0]:
+            return P
     return _slip(W, b, mu, current)
+
+
+@_compiled
+def _norm(x: np.ndarray) -> float:
+    """The 2-norm of a short vector, by a loop (no BLAS call)."""
+    total = 0.0
+    for value in x:
+        total += value * value
+    return np.sqrt(total)
 
 
 def one_contact(G: np.ndarray, q: np.ndarray, mu: float) -> np.ndarray | None:
@@ -288,20 +329,31 @@ def _sweep(
     mu: np.ndarray,
     P: np.ndarray,
 ) -> float:
-    """One Gauss-Seidel sweep over the contacts in place (FCLIB's order); ``|change of P|^2``."""
+    """One Gauss-Seidel sweep over the contacts in place (FCLIB's order); ``|change of P|^2``.
+
+    Explicit loops: numba hands ``@`` and fancy indexing of these small arrays to BLAS calls
+    and temporaries, which cost more than the arithmetic.
+    """
     size = blocks.shape[1]
     change = 0.0
+    b, old = np.empty(size), np.empty(size)
     for j in range(mu.size):
         start = j * size
-        b = np.empty(size)
         for a in range(size):
-            low, high = indptr[start + a], indptr[start + a + 1]
-            b[a] = q[start + a] + np.dot(data[low:high], P[indices[low:high]])
-        old = P[start : start + size].copy()
-        b -= blocks[j] @ old
+            row = start + a
+            total = q[row]
+            for k in range(indptr[row], indptr[row + 1]):
+                total += data[k] * P[indices[k]]
+            b[a] = total
+        for a in range(size):
+            old[a] = P[start + a]
+        for a in range(size):
+            for c in range(size):
+                b[a] -= blocks[j, a, c] * old[c]
         new = solve_contact(blocks[j], inverses[j], b, mu[j], old)
-        P[start : start + size] = new
-        change += np.sum((new - old) ** 2)
+        for a in range(size):
+            change += (new[a] - old[a]) ** 2
+            P[start + a] = new[a]
     return change
 
 
@@ -323,46 +375,48 @@ def inverses(blocks: np.ndarray) -> np.ndarray:
 
 
 def solve_nsgs(
-    G: Any, q: np.ndarray, mu: np.ndarray, d: int, tol: float, start: np.ndarray | None = None
+    W: Any, q: np.ndarray, mu: np.ndarray, dim: int, tol: float, start: np.ndarray | None = None
 ) -> GaussSeidelResult:
     """Coulomb's law ``K ∋ P _|_ uhat ∈ K*`` by nonsmooth Gauss-Seidel (module docstring).
 
     Parameters
     ----------
-    G : array or scipy.sparse matrix (m*(1+d), m*(1+d))
-        The contact Delassus matrix, lawbench's order.
-    q : array (m*(1+d),)
+    W : array or scipy.sparse matrix (m*dim, m*dim)
+        The Delassus operator in FCLIB's order (per contact: normal, then tangents), as given:
+        it need not be symmetric.
+    q : array (m*dim,)
         Local velocity without impulses (restitution included), same order.
     mu : array (m,)
         Friction coefficients, >= 0.
-    d : int
-        Tangential directions per contact (1 planar, 2 spatial).
+    dim : int
+        2 (plane) or 3 (space).
     tol : float
         The FC3D error at which the sweeps stop.
-    start : array (m*(1+d),), optional
+    start : array (m*dim,), optional
         Initial impulses (zero by default).
 
     Returns
     -------
     GaussSeidelResult
-        The impulses, the sweeps and their FC3D error. The error exceeds ``tol`` only when a
-        sweep left ``P`` unchanged (the iteration is stationary).
+        The impulses (FCLIB's order), the sweeps and their FC3D error. The error exceeds
+        ``tol`` only when the iteration is stationary (module docstring).
 
     Raises
     ------
     BudgetExceeded
         When the solve's budget (steps: sweeps, or seconds) runs out first.
     """
-    m, size = len(mu), 1 + d
-    order = local_order(m, d)
-    W = scipy.sparse.csr_matrix(G, dtype=float)[order][:, order]
+    m, size = len(mu), dim
+    W = scipy.sparse.csr_matrix(W, dtype=float)
+    W.sum_duplicates()
     W.sort_indices()
-    local_q = np.ascontiguousarray(np.asarray(q, dtype=float)[order])
+    local_q = np.ascontiguousarray(q, dtype=float)
     mu = np.ascontiguousarray(mu, dtype=float)
     blocks = _blocks(W, m, size)
     inverse = inverses(blocks)
-    P = np.zeros(m * size) if start is None else np.asarray(start, dtype=float)[order]
+    P = np.zeros(m * size) if start is None else np.array(start, dtype=float)
     spend, sweeps, gate, error, note = budget.current(), 0, tol, np.inf, ""
+    reference, reference_sweep = np.inf, 0
     while True:
         spend.step("Gauss-Seidel sweeps", note)
         change = _sweep(W.indptr, W.indices, W.data, blocks, inverse, local_q, mu, P)
@@ -372,9 +426,11 @@ def solve_nsgs(
             error = fc3d_error(W, local_q, mu, P)
             if error <= tol or change == 0.0:
                 break
+            if error < (1.0 - STALL_DROP) * reference:
+                reference, reference_sweep = error, sweeps
+            elif sweeps - reference_sweep >= STALL_SWEEPS:
+                break
             # The error is about proportional to the change: wait until it should be at tol.
             gate = min(gate, light * tol / error)
-        note = f"last change of P {light:.3g}, last FC3D error {error:.3g}, tolerance {tol:g}"
-    answer = np.empty_like(P)
-    answer[order] = P
-    return GaussSeidelResult(answer, sweeps, error)
+            note = f"last change of P {light:.3g}, last FC3D error {error:.3g}, tolerance {tol:g}"
+    return GaussSeidelResult(P, sweeps, error)

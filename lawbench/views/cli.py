@@ -21,6 +21,7 @@ from lawbench.checks import run_checks
 from lawbench.checks.declared import STUDIES
 from lawbench.checks.study import Job
 from lawbench.core.case import CASES, Case
+from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import (
     InvalidProblem,
     LawbenchError,
@@ -35,7 +36,7 @@ from lawbench.core.trial import evaluate
 from lawbench.files.paths import output_file, output_folder
 from lawbench.numerics.transforms import apply
 from lawbench.studies.guard import BUDGET_S, EXECUTORS, alarm
-from lawbench.views.serialize import trial_record
+from lawbench.views.serialize import contact_record, trial_record
 
 
 class Drift(LawbenchError):
@@ -112,6 +113,7 @@ _seconds = _real(
     lambda value: 0 < value <= MAX_SECONDS,
     f"a wall-clock limit is a number of seconds in (0, {MAX_SECONDS:g}]",
 )
+_tolerance = _real(lambda value: 0 < value < 1, "a tolerance is in (0, 1)")
 _fraction = _real(lambda value: 0 <= value < 1, "a fraction is in [0, 1)")
 
 
@@ -276,7 +278,9 @@ def _describe(args: argparse.Namespace) -> None:
         raise InvalidProblem(f"unknown law or case {args.name!r}; known: {known}")
 
 
-def _scene_or_problem(args: argparse.Namespace) -> tuple[str | ImpactProblem, dict[str, str]]:
+def _scene_or_problem(
+    args: argparse.Namespace,
+) -> tuple[str | ImpactProblem | ContactProblem, dict[str, str]]:
     """The scene name and its parameters, or the problem of ``--problem FILE``."""
     params = _assignments(args.set, "--set")
     if (args.case is None) == (args.problem is None):
@@ -305,6 +309,9 @@ def _export(args: argparse.Namespace) -> None:
 def _solve(args: argparse.Namespace) -> None:
     case, params = _scene_or_problem(args)
     options = _assignments(args.option, "--option")
+    if isinstance(case, ContactProblem):
+        _solve_contact(args, case, options)
+        return
     with alarm(args.max_seconds):
         if isinstance(case, str):
             trial = Job(args.law, case, params, options, args.transform or "").solve()
@@ -315,11 +322,7 @@ def _solve(args: argparse.Namespace) -> None:
         from lawbench.files.problem_files import file_diagnostics
 
         record["diagnostics"].update(file_diagnostics(args.problem, trial.outcome))
-    if args.verbose:
-        for heard in record["diagnostics"].get("warnings", ()):
-            print(f"lawbench: warning: {heard}", file=sys.stderr)
-    if args.json:
-        print(json.dumps(record, indent=2, allow_nan=False))
+    if _printed_as_json(args, record):
         return
     print(f"{record['law']} on {record['case']}  (status: {record['status']})")
     print(f"{'coordinate':<16}{'v_minus':>14}{'v_plus':>14}")
@@ -338,6 +341,52 @@ def _solve(args: argparse.Namespace) -> None:
         print(f"  {name:<14}{result['verdict']:<19}{result['detail']}")
         if result["claim"]:
             print(f"  {'':<14}{'':<19}{result['claim']}")
+
+
+def _printed_as_json(args: argparse.Namespace, record: dict) -> bool:
+    """Print a solve's warnings under --verbose, and the record under --json: whether it was."""
+    if args.verbose:
+        for heard in record["diagnostics"].get("warnings", ()):
+            print(f"lawbench: warning: {heard}", file=sys.stderr)
+    if args.json:
+        print(json.dumps(record, indent=2, allow_nan=False))
+    return bool(args.json)
+
+
+# Contacts whose impulses the text output of a contact-space solve lists (--json gives all).
+SHOWN_CONTACTS = 10
+
+
+def _solve_contact(
+    args: argparse.Namespace, problem: ContactProblem, options: dict[str, str]
+) -> None:
+    """``solve LAW --problem FILE`` of a local FCLIB file: the contact-space problem as given."""
+    if args.transform:
+        raise InvalidProblem(
+            "--transform changes an impact problem; a contact-space problem (FCLIB's local "
+            "form) is solved as it is"
+        )
+    with alarm(args.max_seconds):
+        solution = LAWS.get(args.law).solve_contact(problem, **options)
+    record = contact_record(args.law, problem, solution)
+    if _printed_as_json(args, record):
+        return
+    diagnostics = record["diagnostics"]
+    print(f"{record['law']} on {record['case']}  ({problem.m} contacts, dimension {problem.dim})")
+    print(f"{'contact':<10}{'r (normal, tangents)':<44}{'u (normal, tangents)'}")
+    for j in range(min(problem.m, SHOWN_CONTACTS)):
+        span = slice(j * problem.dim, (j + 1) * problem.dim)
+        print(f"{j:<10}{_numbers(solution.r[span]):<44}{_numbers(solution.u[span])}")
+    if problem.m > SHOWN_CONTACTS:
+        print(f"... {problem.m - SHOWN_CONTACTS} more contacts (--json gives all)")
+    print(f"formulation: {diagnostics.get('formulation')}")
+    print(f"FC3D error on the file's own W and q: {record['fc3d_error']:.3g}")
+    print(f"W's asymmetry max|W - W.T| / max|W|: {diagnostics['W_asymmetry']:.3g}")
+    print(f"wall time: {diagnostics['wall_time_s']:.3g} s")
+
+
+def _numbers(values: Sequence[float]) -> str:
+    return ", ".join(f"{value:.6g}" for value in values)
 
 
 def _report(args: argparse.Namespace) -> None:
@@ -457,25 +506,37 @@ def _bench(args: argparse.Namespace) -> None:
 
         print(report(quick=args.quick))
         return
-    from lawbench.studies.bench import bench_problems, performance_profiles, problems_summary
+    from lawbench.studies.bench import (
+        SOLVED_FC3D,
+        bench_problems,
+        performance_profiles,
+        problems_summary,
+    )
 
     out = output_file(args.out, "bench table")
     if out.suffix.lower() != ".csv":
         raise InvalidProblem(f"bench --out {args.out}: the table is CSV (.csv)")
     laws = _names(args.laws, "--laws", LAWS)
+    tol = SOLVED_FC3D if args.tol is None else args.tol
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InvalidProblem(f"bench --out {args.out}: cannot be written ({exc})") from None
-    table, notes = bench_problems(args.problems, args.max_seconds, None if laws == ["*"] else laws)
+    table, notes = bench_problems(
+        args.problems,
+        args.max_seconds,
+        None if laws == ["*"] else laws,
+        tol,
+        args.peer_tol,
+    )
     with out.open("w", encoding="utf-8") as handle:
         handle.writelines(f"# {note}\n" for note in notes)
         table.to_csv(handle, index=False)
     from lawbench.views.plotting import plot_profiles
 
     figure = out.with_suffix(".png")
-    plot_profiles(performance_profiles(table)).figure.savefig(figure, dpi=120)
-    print(problems_summary(table, notes))
+    plot_profiles(performance_profiles(table, tol)).figure.savefig(figure, dpi=120)
+    print(problems_summary(table, notes, tol))
     print(f"table written to {out}, performance profiles to {figure}")
 
 
@@ -812,6 +873,20 @@ def build_parser() -> argparse.ArgumentParser:
         default=PROBLEM_BUDGET_S,
         metavar="S",
         help=f"with --problems: budget of one law on one file (default {PROBLEM_BUDGET_S:g})",
+    )
+    bench.add_argument(
+        "--tol",
+        type=_tolerance,
+        metavar="TOL",
+        help="with --problems: every solver's tolerance, and the FC3D error a solved file has at "
+        "most (default 1e-8, the threshold of Acary, Brémond and Huber's comparisons)",
+    )
+    bench.add_argument(
+        "--peer-tol",
+        type=_tolerance,
+        metavar="TOL",
+        help="with --problems: Siconos' tolerance, where it differs from --tol (the field often "
+        "asks 1e-6)",
     )
     bench.set_defaults(run=_bench)
     return parser

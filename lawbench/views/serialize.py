@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.checks import CheckResult
+from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.trial import Trial
 
 
@@ -48,3 +49,20 @@ def trial_record(trial: Trial, checks: dict[str, CheckResult]) -> dict[str, Any]
     if outcome.path is not None:
         record["path"] = outcome.path
     return plain(record)
+
+
+def contact_record(law: str, problem: ContactProblem, solution: ContactSolution) -> dict[str, Any]:
+    """The JSON object of ``lawbench solve --json`` on a contact-space problem (FCLIB local)."""
+    return plain(
+        {
+            "law": law,
+            "case": problem.name,
+            "contacts": problem.m,
+            "dim": problem.dim,
+            "status": "ok",
+            "r": solution.r,
+            "u": solution.u,
+            "fc3d_error": solution.fc3d_error,
+            "diagnostics": solution.diagnostics,
+        }
+    )
