@@ -297,23 +297,22 @@ class Moreau(Law):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         """Coulomb's law on ``W``, ``q`` as given: the impact with ``e = 0`` in contact space.
 
-        ``nsgs`` sweeps ``W`` itself. The fixed point's cone QPs need a symmetric matrix: they
-        take ``W``'s symmetric part, which moves the answer by about ``W``'s asymmetry, so they
-        solve a ``W`` whose asymmetry is at most ``tol`` and refuse any other.
+        ``nsgs`` sweeps ``W`` itself; the fixed point's cone QPs take ``W``'s symmetric part and
+        iterate its rest with the friction term (`_fixed_point`). Anitescu's relaxation, one
+        convex problem, is refused for an asymmetric ``W``.
         """
         if options["method"] == "nsgs":
             self._refuse_relaxed_nsgs(options)
             return _nsgs(problem.W, problem.q, problem.mu, problem.dim, options)
-        if problem.asymmetry > options["tol"]:
+        if options["friction"] == "relaxed" and problem.asymmetry > 0.0:
             raise NotApplicable(
-                f"moreau: method 'fixed_point' solves cone QPs, whose matrix is symmetric, and "
-                f"this W's asymmetry is {problem.asymmetry:.3g} (above tol = {options['tol']:g}); "
-                "method 'nsgs' solves W as given"
+                f"moreau: Anitescu's relaxation is one convex problem only for a symmetric W; "
+                f"this W's asymmetry is {problem.asymmetry:.3g}"
             )
         m, d = problem.m, problem.dim - 1
         back = np.argsort(local_order(m, d))
         G = problem.W[back][:, back].toarray()
-        P, diagnostics = _fixed_point((G + G.T) / 2, problem.q[back], problem.mu, d, options)
+        P, diagnostics = _fixed_point(G, problem.q[back], problem.mu, d, options)
         return P[local_order(m, d)], diagnostics
 
     def _resolve_batch(
@@ -396,25 +395,34 @@ def _one_contact_or_refuse(G: np.ndarray, q: np.ndarray, mu: np.ndarray) -> np.n
 def _fixed_point(
     G: np.ndarray, q: np.ndarray, mu: np.ndarray, d: int, options: dict[str, Any]
 ) -> tuple[np.ndarray, dict[str, Any]]:
-    """One cone QP (relaxed) or their fixed point (exact): impulses and diagnostics."""
+    """One cone QP (relaxed) or their fixed point (exact): impulses and diagnostics.
+
+    A cone QP's matrix is symmetric: it takes ``G``'s symmetric part, and the rest of ``G``
+    (zero for a mechanical system's Delassus matrix; a file's W can have some) joins the shift
+    of the linear term that the fixed point updates, ``shift = (mu |ut+|, 0) + skew P``, so
+    that at the fixed point the QP's conditions are Coulomb's law on ``G`` itself.
+    """
     m = len(mu)
     exact, tol = options["friction"] == "coulomb", options["tol"]
-    s, steps, iterations, note = np.zeros(m), 0, 0, ""
+    symmetric = (G + G.T) / 2
+    skew = G - symmetric
+    shift, steps, iterations, note = np.zeros(q.size), 0, 0, ""
     spend = budget.current()
     while True:
         spend.step("Coulomb fixed-point steps", note)
-        result = cones.solve_cone_qp(G, q + np.pad(s, (0, m * d)), mu, d, tol, options["polish"])
+        result = cones.solve_cone_qp(symmetric, q + shift, mu, d, tol, options["polish"])
         steps, iterations = steps + 1, iterations + result.iterations
         P, polished = result.P, result.polished
         if not exact:
             break
-        target = mu * np.linalg.norm(cones.split(G @ P + q, m, d)[1], axis=1)
-        change = np.abs(target - s).max()
+        slip = mu * np.linalg.norm(cones.split(G @ P + q, m, d)[1], axis=1)
+        target = np.pad(slip, (0, m * d)) + skew @ P
+        change = np.abs(target - shift).max()
         if change <= tol * np.abs(q).max():
             break
         # Plain substitution first; past UNDAMPED steps average, which breaks the two-cycles
         # the plain iteration can fall into.
-        s = s + (1.0 if steps < UNDAMPED else 0.5) * (target - s)
+        shift = shift + (1.0 if steps < UNDAMPED else 0.5) * (target - shift)
         note = f"last change of mu |ut+| {change:.3g}, tolerance {tol:g}"
     if exact and options["polish"]:
         # The last cone QP had the previous s; solve Coulomb's law itself on its states.

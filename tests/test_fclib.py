@@ -259,26 +259,27 @@ def test_a_global_file_held_sparse_gives_the_dense_answer(monkeypatch):
     assert fclib_diagnostics(path, held_sparse)["fc3d_error"] <= 1e-10
 
 
-def test_an_asymmetric_w_is_solved_as_given_and_its_asymmetry_reported(tmp_path):
-    """A local file whose W is not symmetric is solved on the file's own W: NSGS sweeps W as
-    given to an FC3D error of 1e-10 (Siconos' fc3d_compute_error: 2-norm of the natural map
-    over max(|q|, |r|, |u|)), and the diagnostics give the asymmetry. The fixed point's cone QPs
-    need a symmetric matrix: it refuses a W asymmetric beyond its tolerance, naming the
-    asymmetry. On the command line the JSON carries both."""
+@pytest.mark.parametrize("method", ["nsgs", "fixed_point"])
+def test_an_asymmetric_w_is_solved_as_given_and_its_asymmetry_reported(tmp_path, method):
+    """A local file whose W is not symmetric is solved on the file's own W to an FC3D error of
+    1e-10 (Siconos' fc3d_compute_error: 2-norm of the natural map over max(|q|, |r|, |u|)):
+    NSGS sweeps W as given, the fixed point's cone QPs take W's symmetric part and iterate the
+    rest with the friction term. The diagnostics give the asymmetry; Anitescu's relaxation,
+    one convex problem, refuses it by name. On the command line the JSON carries both."""
     W, q, mu = random_local(np.random.default_rng(11), 3)
     skew = np.triu(np.full_like(W, 1e-4), 1)
     fclib_local(tmp_path / "asym.hdf5", W + skew - skew.T, q, mu, "csc")
     problem = read_fclib(tmp_path / "asym.hdf5")
     moreau = lawbench.LAWS["moreau"]
-    solution = moreau.solve_contact(problem, method="nsgs")
+    solution = moreau.solve_contact(problem, method=method)
     assert solution.diagnostics["W_asymmetry"] == pytest.approx(
         2e-4 / np.abs(W + skew - skew.T).max()
     )
     assert solution.fc3d_error <= 1e-10
     assert_de_saxce(W + skew - skew.T, q, mu, solution.r, 1e-8)
     with pytest.raises(lawbench.NotApplicable, match=r"asymmetry is 2\.\d+e-05"):
-        moreau.solve_contact(problem)
-    record = solved_from_the_command_line(tmp_path, "asym.hdf5", "--option", "method=nsgs")
+        moreau.solve_contact(problem, friction="relaxed")
+    record = solved_from_the_command_line(tmp_path, "asym.hdf5", "--option", f"method={method}")
     assert record["fc3d_error"] == pytest.approx(solution.fc3d_error, abs=1e-13)
     assert record["diagnostics"]["W_asymmetry"] == solution.diagnostics["W_asymmetry"]
 

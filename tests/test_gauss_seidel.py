@@ -99,8 +99,9 @@ def test_nsgs_solves_the_committed_fclib_files(path):
 def test_a_stationary_iteration_on_a_singular_w_fails_naming_the_rank():
     """Siconos' test problem OneObject-i100000-499, written by Siconos' FCLIB writer: its W has
     rank 49 of 72, and nonsmooth Gauss-Seidel settles at an FC3D error of 4.3e-5 (Siconos'
-    fc3d_nsgs ends at 9.9e-4 after 100000 sweeps). The sweeps stop once the error has not
-    fallen by a millionth over a thousand sweeps, and the failure says why."""
+    fc3d_nsgs ends at 9.9e-4 after 100000 sweeps). The sweeps stop once the error has found no
+    new low for a thousand sweeps (and as many as the last low took), and the failure says
+    why."""
     problem = read_fclib(next(path for path in FCLIB if path.stem == STALLS))
     with pytest.raises(SolverFailure, match=r"stationary after \d+ sweeps at FC3D error") as e:
         MOREAU.solve_contact(problem, method="nsgs", tol=1e-8)

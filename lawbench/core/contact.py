@@ -66,18 +66,21 @@ class ContactProblem:
         q = np.array(self.q, dtype=float).ravel()
         size = mu.size * self.dim
         try:
-            W = scipy.sparse.csr_array(self.W, dtype=float)
+            W = scipy.sparse.csr_array(self.W, dtype=float, copy=True)
         except (TypeError, ValueError) as exc:
             raise InvalidProblem(f"{where}: W is not a numeric matrix ({exc})") from None
+        # Stored zeros (a writer that saves a dense block as sparse) change no entry of W and
+        # would cost every Gauss-Seidel sweep their time.
         W.sum_duplicates()
+        W.eliminate_zeros()
         W.sort_indices()
+        if mu.size == 0:
+            raise InvalidProblem(f"{where}: mu is empty (no contact)")
         if W.shape != (size, size) or q.size != size:
             raise InvalidProblem(
                 f"{where}: W is {W.shape[0]} x {W.shape[1]} and q holds {q.size} entries; "
                 f"{mu.size} contacts of dimension {self.dim} need {size} x {size} and {size}"
             )
-        if mu.size == 0:
-            raise InvalidProblem(f"{where}: mu is empty (no contact)")
         for label, values in (("W", W.data), ("q", q), ("mu", mu)):
             if not np.isfinite(values).all():
                 raise InvalidProblem(f"{where}: {label} holds a number that is not finite")

@@ -29,9 +29,10 @@ solved by Siconos' fallback, the projection iteration
 ``P_j <- proj_K(P_j - (u_j + (mu_j |ut_j|, 0)) / W_nn)`` (Acary et al. 2018, eq. 4.4).
 
 Sweeps go on until the FC3D error (`lawbench.core.mechanics.fc3d_error`) is at most ``tol``, or
-until the iteration is stationary: a sweep leaves ``P`` unchanged, or the error has not fallen
-by a millionth over a thousand sweeps (on a singular Delassus matrix Gauss-Seidel can settle on a
-point that is no solution, as Siconos' NSGS does on the same problems). The error
+until the iteration is stationary: a sweep leaves ``P`` unchanged, or the error has not reached
+a new low (by a millionth) for a thousand sweeps and for as many sweeps as the last low took (on
+a singular Delassus matrix Gauss-Seidel can settle on a point that is no solution, as Siconos'
+NSGS does on the same problems; a slow but steady descent always finds new lows). The error
 costs about as much as a sweep, so, like Siconos' light-then-full evaluation, it is computed
 when the relative change of ``P`` over a sweep falls below a gate (``tol`` at first, lowered by
 the ratio of the error found to ``tol``), and every `CHECK_EVERY` sweeps. Each sweep spends one
@@ -80,8 +81,8 @@ SINGULAR = 1e12
 ANGLE_STEPS, ALIGNED = 50, 1e-8
 # Sweeps between two evaluations of the FC3D error while the change of P stays above the gate.
 CHECK_EVERY = 10
-# The iteration is stationary when its FC3D error has not fallen by a fraction STALL_DROP over
-# STALL_SWEEPS sweeps: at that pace reaching a tolerance would take millions of sweeps.
+# The iteration is stationary when its FC3D error has not reached a new low, by a fraction
+# STALL_DROP, for STALL_SWEEPS sweeps and for as many sweeps as it took to reach the last low.
 STALL_DROP, STALL_SWEEPS = 1e-6, 1000
 # Projection steps of the fallback local solver.
 FALLBACK_STEPS = 200
@@ -407,8 +408,9 @@ def solve_nsgs(
         When the solve's budget (steps: sweeps, or seconds) runs out first.
     """
     m, size = len(mu), dim
-    W = scipy.sparse.csr_matrix(W, dtype=float)
+    W = scipy.sparse.csr_matrix(W, dtype=float, copy=True)
     W.sum_duplicates()
+    W.eliminate_zeros()
     W.sort_indices()
     local_q = np.ascontiguousarray(q, dtype=float)
     mu = np.ascontiguousarray(mu, dtype=float)
@@ -428,7 +430,7 @@ def solve_nsgs(
                 break
             if error < (1.0 - STALL_DROP) * reference:
                 reference, reference_sweep = error, sweeps
-            elif sweeps - reference_sweep >= STALL_SWEEPS:
+            elif sweeps - reference_sweep >= max(STALL_SWEEPS, reference_sweep):
                 break
             # The error is about proportional to the change: wait until it should be at tol.
             gate = min(gate, light * tol / error)
