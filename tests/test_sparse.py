@@ -9,6 +9,7 @@ from lawbench import Contact, ImpactProblem, InvalidProblem
 from lawbench.core.problem import SMALL
 from lawbench.files.problem_files import load_problem, save_problem
 from lawbench.numerics.chains import SPARSE_CONTACTS
+from lawbench.numerics.solvers import _solve_block
 
 
 def random_chain(seed, sparse, banded=False):
@@ -144,6 +145,42 @@ def test_a_ten_thousand_ball_chain_solves_sparse():
     outcome = lawbench.LAWS.get("moreau").resolve(problem)
     assert outcome.diagnostics["polished"]
     np.testing.assert_allclose(outcome.v_plus, masses @ velocities / masses.sum(), atol=1e-10)
+
+
+def block_of(pattern, n=200):
+    """A symmetric, diagonally dominant block (COO) of ``pattern``, and its dense copy.
+
+    ``split entries`` lists each diagonal entry of a tridiagonal block in two halves.
+    """
+    rng = np.random.default_rng(len(pattern))
+    width = {"tridiagonal": 1, "pentadiagonal": 2, "arrow": 1, "split entries": 1}[pattern]
+    dense = np.zeros((n, n))
+    for offset in range(1, width + 1):
+        coupling = rng.uniform(-1.0, 1.0, n - offset)
+        dense += np.diag(coupling, offset) + np.diag(coupling, -offset)
+    if pattern == "arrow":
+        dense[0, 1:] = dense[1:, 0] = rng.uniform(-1.0, 1.0, n - 1) / n
+    dense += np.diag(4.0 * width + 10.0 ** rng.uniform(-1.0, 1.0, n))
+    if pattern != "split entries":
+        return scipy.sparse.coo_array(dense), dense
+    half, diagonal = np.diag(dense) / 2, np.arange(n)
+    block = scipy.sparse.coo_array(dense - np.diag(half))
+    block = scipy.sparse.coo_array(
+        (np.r_[block.data, half], (np.r_[block.row, diagonal], np.r_[block.col, diagonal])),
+        shape=(n, n),
+    )
+    return block, dense
+
+
+@pytest.mark.parametrize("pattern", ["tridiagonal", "pentadiagonal", "arrow", "split entries"])
+def test_a_sparse_block_of_the_polish_is_solved_as_a_dense_one(pattern):
+    """Banded blocks by banded Cholesky, the others by sparse LU: a dense solve's answer."""
+    block, dense = block_of(pattern)
+    rhs = np.random.default_rng(1).normal(size=len(dense))
+    expected = np.linalg.solve(dense, rhs)
+    for given in (block, dense):
+        solution = _solve_block(given, rhs)
+        np.testing.assert_allclose(solution, expected, rtol=0, atol=1e-13 * np.abs(expected).max())
 
 
 def test_a_dense_law_refuses_a_problem_too_large_to_hold_dense():

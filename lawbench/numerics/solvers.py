@@ -122,8 +122,9 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
     exact = np.zeros_like(q)
     if active.any():
         rows = np.flatnonzero(active)
+        block = G if rows.size == len(q) else G[np.ix_(rows, rows)]
         try:
-            exact[active] = _solve_block(G[np.ix_(rows, rows)], -q[active])
+            exact[active] = _solve_block(block, -q[active])
         except (np.linalg.LinAlgError, ValueError):
             return None
     slack = G @ exact + q
@@ -139,14 +140,22 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
 def _solve_block(block: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Solve a symmetric positive (semi)definite block of a Delassus matrix.
 
-    Sparse LU when it is sparse, or large with few non-zero entries (the banded blocks of
-    chains), a dense solve otherwise.
+    When it is sparse, or large with few non-zero entries: by banded Cholesky when its band
+    holds no more entries than its non-zero ones (chains: each contact shares a body with its
+    neighbours only, so the block is tridiagonal), else, or when it is only semidefinite, by
+    sparse LU. A dense solve otherwise.
 
     An ill-conditioned block (redundant contacts) is fine: the caller checks the answer.
     """
     if is_sparse(block) or (
         block.shape[0] > SPARSE_SIZE and np.count_nonzero(block) <= SPARSE_SHARE * block.size
     ):
+        band = _lower_band(block)
+        if band is not None:
+            try:
+                return scipy.linalg.solveh_banded(band, rhs, lower=True)
+            except np.linalg.LinAlgError:  # not positive definite: sparse LU decides
+                pass
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", scipy.sparse.linalg.MatrixRankWarning)
             solution = scipy.sparse.linalg.spsolve(scipy.sparse.csc_matrix(block), rhs)
@@ -156,6 +165,24 @@ def _solve_block(block: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
         return scipy.linalg.solve(block, rhs, assume_a="pos")
+
+
+def _lower_band(block: np.ndarray) -> np.ndarray | None:
+    """The lower band of a symmetric block in LAPACK's storage (``band[i - j, j] = block[i, j]``).
+
+    None when the band would hold more entries than the block's non-zero ones: the block is not
+    banded, and its band is no cheaper than a sparse factor.
+    """
+    entries = scipy.sparse.coo_array(block)
+    offset = entries.row - entries.col
+    width = int(offset.max(initial=0))
+    if (width + 1) * block.shape[0] > entries.nnz:
+        return None
+    lower = offset >= 0
+    band = np.zeros((width + 1, block.shape[0]))
+    # Added, not assigned: a sparse block may list an entry in several parts.
+    np.add.at(band, (offset[lower], entries.col[lower]), entries.data[lower])
+    return band
 
 
 @functools.cache
