@@ -267,7 +267,7 @@ class Moreau(Law):
         if problem.frictional:
             return _resolve_friction(problem, e * restituted, options)
         large = problem.m > ENUMERATION_MAX
-        single_e = large and len(set(e)) == 1 and np.array_equal(restituted, un)
+        single_e = large and (e == e[0]).all() and np.array_equal(restituted, un)
         if single_e and large and not is_diagonal(problem.delassus):
             plastic = project_on_cone(
                 problem.M,
