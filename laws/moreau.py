@@ -80,6 +80,14 @@ frictionless formulations above do not depend on it:
   the fixed point's interior-point steps still find the contact states. Diagnostics:
   ``sweeps`` (and ``iterations``, the same), ``polished``, ``fc3d_error``.
 
+In contact space (`Law.solve_contact`: FCLIB's local form, ``W``, ``q`` and ``mu`` as a file
+holds them, the impact with ``e = 0``) both methods solve Coulomb's law on ``W`` as given:
+Gauss-Seidel sweeps it, and the fixed point's cone QPs take its symmetric part while the rest,
+``skew = W - (W + W.T) / 2``, joins the friction term in the linear term they iterate
+(``q + (mu |ut+|, 0) + skew P``); at the fixed point the QP's conditions are De Saxce's on
+``W`` itself. A Delassus matrix of a mechanical system is symmetric; files from the field can
+be asymmetric by 1e-3, and Anitescu's relaxation, one convex problem, refuses them.
+
 An answer that leaves a contact approaching (``un+ + e r`` below ``-sqrt(tol)`` of the largest
 local velocity) breaks the normal law: with ``mu`` near 1e300 the modified velocity loses ``un``
 to rounding and a zero impulse passes the cone conditions. With one contact the law's states
@@ -126,7 +134,7 @@ from lawbench.laws._claims import (
 )
 from lawbench.numerics import cones
 from lawbench.numerics.gauss_seidel import (
-    COMPILED,
+    compiled,
     error_of,
     in_local_order,
     local_order,
@@ -499,7 +507,7 @@ def _nsgs(
             f"above the tolerance {tol:g}{_rank_note(W)}"
         )
     diagnostics = {
-        "formulation": "NSGS, exact local solver" + (" (numba)" if COMPILED else ""),
+        "formulation": "NSGS, exact local solver" + (" (numba)" if compiled() else ""),
         "solver_status": "converged",
         "iterations": result.sweeps,
         "sweeps": result.sweeps,

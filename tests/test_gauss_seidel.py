@@ -178,7 +178,7 @@ import sys
 sys.modules["numba"] = None
 import numpy as np
 from lawbench.numerics import gauss_seidel
-assert not gauss_seidel.COMPILED
+assert not gauss_seidel.compiled()
 G = np.array({G})
 print(gauss_seidel.solve_nsgs(G, np.array({q}), np.array({mu}), 3, 1e-12).P.tolist())
 """

@@ -39,14 +39,16 @@ the ratio of the error found to ``tol``), and every `CHECK_EVERY` sweeps. Each s
 step of the solve's budget (`lawbench.core.budget`), so the loop ends at the law's ``max_steps``
 or ``max_seconds``.
 
-The per-contact kernel and the sweep are compiled by numba when it is installed
-(``pip install 'lawbench[fast]'``); the same functions run as plain Python without it.
+The per-contact kernel and the sweep are compiled by numba at the first solve where it is
+installed (``pip install 'lawbench[fast]'``, `compiled`); the same functions run as plain
+Python without it.
 ``W`` may be dense or scipy.sparse: it is held in compressed rows, so a sweep costs time
 proportional to its non-zero entries.
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
@@ -58,21 +60,34 @@ from lawbench.core import budget
 from lawbench.core.mechanics import fc3d_error, project
 
 _F = TypeVar("_F", bound=Callable[..., Any])
-
-try:
-    import numba
-except ImportError:  # the optional extra 'fast' is not installed: plain Python
-    numba = None
+# The kernels numba compiles, by their names in this module.
+_KERNELS: list[str] = []
 
 
-def _compiled(function: _F) -> _F:
-    """``function`` compiled by numba (nopython mode) when it is installed, else itself."""
-    if numba is None:
-        return function
-    return numba.njit(cache=True)(function)
+def _kernel(function: _F) -> _F:
+    """Mark ``function`` for numba (`compiled`); until then it is plain Python."""
+    _KERNELS.append(function.__name__)
+    return function
 
 
-COMPILED = numba is not None
+@functools.cache
+def compiled() -> bool:
+    """Compile the kernels with numba, once, where it is installed; whether they are compiled.
+
+    numba is imported here, at the first solve, not with the module: its import costs a
+    process 0.25 s and 55 MB, and most processes that load Moreau's law never sweep. The module's
+    names are bound to the compiled functions, which find each other there when they compile.
+    """
+    try:
+        import numba
+    except ImportError:  # the optional extra 'fast' is not installed: plain Python
+        return False
+    namespace = globals()
+    for name in _KERNELS:
+        namespace[name] = numba.njit(cache=True)(namespace[name])
+    return True
+
+
 # A block whose condition number exceeds this has no reliable stick solution.
 SINGULAR = 1e12
 # Newton steps at most refining a root of the slip angle (a root of the quartic off the unit
@@ -88,7 +103,9 @@ STALL_DROP, STALL_SWEEPS = 1e-6, 1000
 FALLBACK_STEPS = 200
 TINY = np.finfo(float).tiny
 
-_project = _compiled(project)
+# Coulomb's cone projection, compiled for the fallback local solver.
+_project = project
+_KERNELS.append("_project")
 
 
 @dataclass(frozen=True)
@@ -118,7 +135,7 @@ def error_of(G: Any, q: np.ndarray, mu: np.ndarray, d: int, P: np.ndarray) -> fl
     return fc3d_error(W, local_q, mu, P[local_order(len(mu), d)])
 
 
-@_compiled
+@_kernel
 def _angle_terms(W: np.ndarray, b: np.ndarray, mu: float) -> tuple[np.ndarray, ...]:
     """``A``, ``B``, ``C`` of ``V(t) = A + B cos t + C sin t = (W_nn - mu W_nt e) ut`` (spatial)."""
     bn, bt, wnt = b[0], b[1:], W[0, 1:]
@@ -128,7 +145,7 @@ def _angle_terms(W: np.ndarray, b: np.ndarray, mu: float) -> tuple[np.ndarray, .
     return A, B, C
 
 
-@_compiled
+@_kernel
 def _refined(A: np.ndarray, B: np.ndarray, C: np.ndarray, angle: float) -> np.ndarray:
     """The unit direction at the root of ``e x V(t)`` Newton's method reaches from ``angle``."""
     for _ in range(ANGLE_STEPS):
@@ -145,7 +162,7 @@ def _refined(A: np.ndarray, B: np.ndarray, C: np.ndarray, angle: float) -> np.nd
     return np.array([np.cos(angle), np.sin(angle)])
 
 
-@_compiled
+@_kernel
 def _slip_directions(W: np.ndarray, b: np.ndarray, mu: float) -> np.ndarray:
     """Every candidate unit slip direction ``e`` (rows): ``+1`` and ``-1`` in the plane.
 
@@ -175,7 +192,7 @@ def _slip_directions(W: np.ndarray, b: np.ndarray, mu: float) -> np.ndarray:
     return directions
 
 
-@_compiled
+@_kernel
 def _slip_along(W: np.ndarray, b: np.ndarray, mu: float, e: np.ndarray) -> np.ndarray:
     """The slipping impulse along the unit direction ``e``, or an empty array if it is none.
 
@@ -211,7 +228,7 @@ def _slip_along(W: np.ndarray, b: np.ndarray, mu: float, e: np.ndarray) -> np.nd
     return P
 
 
-@_compiled
+@_kernel
 def _slip(W: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray) -> np.ndarray:
     """The slipping impulse, or an empty array when no direction qualifies.
 
@@ -233,7 +250,7 @@ def _slip(W: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray) -> np.nd
     return best
 
 
-@_compiled
+@_kernel
 def _projected(W: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray) -> np.ndarray:
     """The fallback: projection steps ``P <- proj_K(P - uhat / W_nn)`` from ``current``."""
     P = current.copy()
@@ -247,7 +264,7 @@ def _projected(W: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray) -> 
     return P
 
 
-@_compiled
+@_kernel
 def solve_contact(
     W: np.ndarray, inverse: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray
 ) -> np.ndarray:
@@ -277,7 +294,7 @@ def solve_contact(
     return P if P.size else _projected(W, b, mu, current)
 
 
-@_compiled
+@_kernel
 def _in_a_state(
     W: np.ndarray, inverse: np.ndarray, b: np.ndarray, mu: float, current: np.ndarray
 ) -> np.ndarray:
@@ -298,7 +315,7 @@ def _in_a_state(
     return _slip(W, b, mu, current)
 
 
-@_compiled
+@_kernel
 def _norm(x: np.ndarray) -> float:
     """The 2-norm of a short vector, by a loop (no BLAS call)."""
     total = 0.0
@@ -314,12 +331,13 @@ def one_contact(G: np.ndarray, q: np.ndarray, mu: float) -> np.ndarray | None:
     the law (Coulomb's law with kinematic restitution can have no solution when the normal
     and tangential directions are strongly coupled, as Painlevé's examples).
     """
+    compiled()
     G = np.asarray(G, dtype=float)
     P = _in_a_state(G, inverses(G[None])[0], np.asarray(q, dtype=float), mu, np.zeros(q.size))
     return P if P.size else None
 
 
-@_compiled
+@_kernel
 def _sweep(
     indptr: np.ndarray,
     indices: np.ndarray,
@@ -407,6 +425,7 @@ def solve_nsgs(
     BudgetExceeded
         When the solve's budget (steps: sweeps, or seconds) runs out first.
     """
+    compiled()
     m, size = len(mu), dim
     W = scipy.sparse.csr_matrix(W, dtype=float, copy=True)
     W.sum_duplicates()
