@@ -146,8 +146,11 @@ def test_a_file_that_is_not_an_impact_problem_is_refused_by_name(tmp_path):
 
 # Problems written by Siconos and LMGC90 (tests/data/fclib/README.md).
 DATA = Path(__file__).parent / "data" / "fclib"
-FIELD = sorted(path for path in DATA.glob("*.hdf5") if "fclib_global" in h5py.File(path, "r"))
-LOCAL = sorted(path for path in DATA.glob("*.hdf5") if path not in FIELD)
+GLOBAL = sorted(path for path in DATA.glob("*.hdf5") if "fclib_global" in h5py.File(path, "r"))
+LOCAL = sorted(path for path in DATA.glob("*.hdf5") if path not in GLOBAL)
+# A global form whose M is not symmetric: no impact problem (tests/data/fclib/README.md).
+NOT_AN_IMPACT = DATA / "LMGC_GlobalFrictionContactProblem00046.hdf5"
+FIELD = [path for path in GLOBAL if path != NOT_AN_IMPACT]
 
 
 def coulomb_projection(x, mu):
@@ -238,6 +241,46 @@ def test_local_problems_from_siconos_and_lmgc90_are_solved_as_given(path):
     _, least_outside, least_asymmetry = AS_GIVEN[path.stem]
     assert np.linalg.norm(outside) >= least_outside * np.linalg.norm(q)
     assert asymmetry >= least_asymmetry
+
+
+@pytest.mark.parametrize("method", ["nsgs", "fixed_point"])
+def test_a_global_form_that_is_no_impact_is_solved_in_contact_space(method):
+    """LMGC90's global problem 00046 has an M that is not symmetric (largest |M - M.T| = 39.2),
+    which no impact problem has: it is read as Siconos reformulates it, W = H.T M^-1 H and
+    q = H.T M^-1 f + w, computed here with h5py and numpy from the file's own M, H, f and w,
+    and solved to an FC3D error of 1e-10 on them."""
+    with h5py.File(NOT_AN_IMPACT, "r") as handle:
+        root = handle["fclib_global"]
+        M, H = triplets(root["M"]).toarray(), triplets(root["H"]).toarray()
+        f, w = (np.asarray(root["vectors"][k][()], dtype=float).ravel() for k in "fw")
+        mu = np.asarray(root["vectors"]["mu"][()], dtype=float).ravel()
+    assert np.abs(M - M.T).max() > 39
+    W, q = H.T @ np.linalg.solve(M, H), H.T @ np.linalg.solve(M, f) + w
+    problem = read_fclib(NOT_AN_IMPACT)
+    assert isinstance(problem, lawbench.ContactProblem)
+    assert "M is not symmetric" in problem.name
+    np.testing.assert_allclose(problem.W.toarray(), W, rtol=0, atol=1e-12 * np.abs(W).max())
+    np.testing.assert_allclose(problem.q, q, rtol=0, atol=1e-12 * np.abs(q).max())
+    solution = lawbench.LAWS["moreau"].solve_contact(problem, method=method)
+    assert solution.fc3d_error <= 1e-10
+    assert_de_saxce(W, q, mu, solution.r, 1e-8)
+
+
+def test_a_global_form_with_an_offset_is_read_in_contact_space(tmp_path):
+    """An offset w (a constant local velocity) has no impact counterpart: the file is read as
+    q = H.T M^-1 f + w, W = H.T M^-1 H, and the offset is named."""
+    problem = lawbench.CASES["billiard"].build(e=0.0)
+    path = write_fclib(problem, tmp_path / "offset.hdf5", "global")
+    with h5py.File(path, "r+") as handle:
+        w = handle["fclib_global/vectors/w"]
+        w[...] = np.linspace(-0.1, 0.1, w.shape[0])
+        offset = w[()]
+    read = read_fclib(path)
+    assert isinstance(read, lawbench.ContactProblem) and "w, a constant local velocity" in read.name
+    m, d = problem.m, problem.d
+    order = np.column_stack([np.arange(m), m + np.arange(m)[:, None] * d + np.arange(d)]).ravel()
+    q = (problem.W.T @ problem.v)[order] + offset
+    np.testing.assert_allclose(read.q, q, rtol=0, atol=1e-12 * np.abs(q).max())
 
 
 def test_a_global_file_held_sparse_gives_the_dense_answer(monkeypatch):

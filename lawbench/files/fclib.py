@@ -13,8 +13,10 @@ has one entry per contact; ``spacedim`` is 3 (or 2).
 
 The global form is exactly an impact with ``e = 0`` resolved by Moreau's law with Coulomb
 cones: `read_fclib` maps it to an `ImpactProblem` with ``M``, ``W = H`` (normal columns
-``Wn``, tangential ``Wt``) and the pre-impact velocity ``v- = M^-1 f``; an offset ``w`` has no
-counterpart in an impact problem and is refused. The local form has no generalized
+``Wn``, tangential ``Wt``) and the pre-impact velocity ``v- = M^-1 f``. A global form that is
+no impact, its ``M`` not symmetric (LMGC90 writes such iteration matrices) or with an offset
+``w``, is read in contact space as Siconos reformulates it, ``W = H.T M^-1 H`` and
+``q = H.T M^-1 f + w``, the reason in the problem's name. The local form has no generalized
 coordinates: it is read as the `ContactProblem` it is, ``W`` and ``q`` as given (an asymmetric
 ``W`` is kept, and its asymmetry reported by the solve; ``q`` need not lie in the range of
 ``W``). `fclib_diagnostics` gives the FC3D error of a global problem's answer on the file's own
@@ -50,6 +52,9 @@ FORMS = ("local", "global")
 # The largest matrix of a global form held dense (entries, 8 MB of doubles); larger ones are
 # held sparse, as a local form's W always is.
 DENSE_ENTRIES = 1_000_000
+# The relative asymmetry of M beyond which a global form is no impact problem: the impact
+# problem's own bound on its mass matrix.
+MASS_SYMMETRY = 1e-12
 # FCLIB files are HDF5: an extension that names another encoding would mislead every reader.
 SUFFIXES = (".h5", ".hdf5")
 # FCLIB's forms that are not frictional impacts, by their HDF5 group: recognised, and refused.
@@ -58,12 +63,19 @@ OTHER_FORMS = {"fclib_global_rolling": "the global problem with rolling friction
 
 def is_fclib(path: str | Path) -> bool:
     """Whether ``path`` is an HDF5 file holding an FCLIB problem (of any form)."""
+    return fclib_form(path) is not None
+
+
+def fclib_form(path: str | Path) -> str | None:
+    """The FCLIB form ``path`` holds ('local', 'global' or another of FCLIB's), or None."""
     try:
         with require_h5py().File(path, "r") as handle:
-            groups = [f"fclib_{form}" for form in FORMS] + list(OTHER_FORMS)
-            return any(group in handle for group in groups)
+            for group in [f"fclib_{form}" for form in FORMS] + list(OTHER_FORMS):
+                if group in handle:
+                    return group.removeprefix("fclib_")
     except (OSError, RuntimeError, KeyError):  # not HDF5, or a damaged one
-        return False
+        return None
+    return None
 
 
 def _read_matrix(group: Any, where: str) -> scipy.sparse.csr_matrix:
@@ -214,14 +226,15 @@ def _opened(path: str | Path) -> Iterator[tuple[Any, str, str, int]]:
 def read_fclib(path: str | Path) -> ImpactProblem | ContactProblem:
     """Read an FCLIB file: the global form as an impact, the local form as given.
 
-    The global form is an `ImpactProblem` with ``e = 0``; the local form a `ContactProblem`
-    with ``W`` and ``q`` as the file holds them.
+    The global form is an `ImpactProblem` with ``e = 0`` (or, when its ``M`` is not symmetric
+    or it has an offset ``w``, the `ContactProblem` ``W = H.T M^-1 H``, ``q = H.T M^-1 f + w``);
+    the local form a `ContactProblem` with ``W`` and ``q`` as the file holds them.
 
     Raises
     ------
     InvalidProblem
         For a file that is not FCLIB, a missing field, a form this mapping cannot represent
-        (equality constraints, an offset ``w``, a mixed local problem), or a bad field of the
+        (equality constraints, a mixed local problem), a singular ``M``, or a bad field of the
         resulting problem; the message names the field.
     NotApplicable
         For FCLIB's rolling-friction form: no impact law here has rolling resistance.
@@ -240,16 +253,28 @@ def read_fclib(path: str | Path) -> ImpactProblem | ContactProblem:
         H = _held(_read_matrix(root["H"], f"{where}/H"))
         f = _vector(vectors, "f", f"{where}/vectors")
         w = _vector(vectors, "w", f"{where}/vectors")
-        if np.any(w):
-            raise InvalidProblem(
-                f"{where}/vectors/w: a constant local velocity has no impact counterpart"
-            )
+    reason = _no_impact(M, w)
+    if reason:
+        # Siconos' reformulation of the global form: W = H.T M^-1 H, q = H.T M^-1 f + w.
+        W = H.T @ _solve(M, as_array(H), where)
+        q = H.T @ _solve(M, f, where) + w
+        return ContactProblem(W, q, mu, dim, name=f"{where} (in contact space: {reason})")
     try:
         return ImpactProblem.from_arrays(
             M, v=_solve(M, f, where), **_split(H, dim, mu, where), e=0.0, mu=mu
         )
     except InvalidProblem as exc:
         raise InvalidProblem(f"{where}: {exc}") from None
+
+
+def _no_impact(M: Any, w: np.ndarray) -> str:
+    """Why a global form is no impact problem (its M not symmetric, an offset w), or ''."""
+    asymmetry = abs(M - M.T).max()
+    if asymmetry > MASS_SYMMETRY * abs(M).max():
+        return f"M is not symmetric, largest |M - M.T| = {asymmetry:.3g}"
+    if np.any(w):
+        return "w, a constant local velocity, has no impact counterpart"
+    return ""
 
 
 def _local(root: Any, size: int, where: str) -> tuple[Any, np.ndarray]:

@@ -46,6 +46,7 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem, as_array
 from lawbench.core.registry import Registry
 from lawbench.core.trial import solve_batch
+from lawbench.files.fclib import fclib_form
 from lawbench.numerics.chains import chain_problem
 from lawbench.numerics.gauss_seidel import local_order
 from lawbench.numerics.solvers import clarabel_settings, enumerate_lcp
@@ -600,9 +601,10 @@ def siconos_nsgs(
     local = _as_contact_problem(problem)
     if local is None:
         raise NotApplicable("siconos: fc3d_nsgs solves spatial frictional problems")
-    if path and isinstance(problem, ContactProblem):
+    form = fclib_form(path) if path else None
+    if form == "local":
         fcp = sn.frictionContact_fclib_read(path)
-    elif path:
+    elif form == "global":
         fcp = sn.globalFrictionContact_reformulation_FrictionContact(
             sn.globalFrictionContact_fclib_read(path)
         )
