@@ -17,6 +17,7 @@ tangents; ``dim`` is 3 in space, 2 in the plane.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -99,13 +100,15 @@ class ContactProblem:
         object.__setattr__(self, "W", W)
         object.__setattr__(self, "q", q)
         object.__setattr__(self, "mu", mu)
+        # Known from the start: every solution reports it, and no solve should pay for it.
+        self.asymmetry  # noqa: B018
 
     @property
     def m(self) -> int:
         """The number of contacts."""
         return self.mu.size
 
-    @property
+    @functools.cached_property
     def asymmetry(self) -> float:
         """``max |W - W.T| / max |W|``: zero for a Delassus matrix of a mechanical system."""
         largest = float(np.abs(self.W.data).max(initial=0.0))

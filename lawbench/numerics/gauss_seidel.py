@@ -376,13 +376,19 @@ def _sweep(
     return change
 
 
-def _blocks(W: scipy.sparse.csr_matrix, m: int, size: int) -> np.ndarray:
-    """The diagonal blocks (m, size, size) of ``W`` in FCLIB's order."""
-    first = np.arange(m)[:, None, None] * size
-    rows = first + np.arange(size)[:, None]
-    columns = first + np.arange(size)[None, :]
-    rows, columns = np.broadcast_arrays(rows, columns)
-    return np.asarray(W[rows.ravel(), columns.ravel()]).reshape(m, size, size).copy()
+@_kernel
+def _blocks(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, size: int) -> np.ndarray:
+    """The diagonal blocks (m, size, size) of a CSR matrix in FCLIB's order."""
+    m = (indptr.size - 1) // size
+    blocks = np.zeros((m, size, size))
+    for j in range(m):
+        for a in range(size):
+            row = j * size + a
+            for k in range(indptr[row], indptr[row + 1]):
+                column = indices[k] - j * size
+                if 0 <= column < size:
+                    blocks[j, a, column] += data[k]
+    return blocks
 
 
 def inverses(blocks: np.ndarray) -> np.ndarray:
@@ -427,13 +433,14 @@ def solve_nsgs(
     """
     compiled()
     m, size = len(mu), dim
-    W = scipy.sparse.csr_matrix(W, dtype=float, copy=True)
-    W.sum_duplicates()
-    W.eliminate_zeros()
-    W.sort_indices()
+    W = scipy.sparse.csr_matrix(W, dtype=float)
+    if not W.has_canonical_format or not W.data.all():
+        W = W.copy()
+        W.sum_duplicates()
+        W.eliminate_zeros()
     local_q = np.ascontiguousarray(q, dtype=float)
     mu = np.ascontiguousarray(mu, dtype=float)
-    blocks = _blocks(W, m, size)
+    blocks = _blocks(W.indptr, W.indices, W.data, size)
     inverse = inverses(blocks)
     P = np.zeros(m * size) if start is None else np.array(start, dtype=float)
     spend, sweeps, gate, error, note = budget.current(), 0, tol, np.inf, ""
