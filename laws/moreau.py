@@ -306,8 +306,10 @@ class Moreau(Law):
         """Coulomb's law on ``W``, ``q`` as given: the impact with ``e = 0`` in contact space.
 
         ``nsgs`` sweeps ``W`` itself; the fixed point's cone QPs take ``W``'s symmetric part and
-        iterate its rest with the friction term (`_fixed_point`). Anitescu's relaxation, one
-        convex problem, is refused for an asymmetric ``W``.
+        iterate its rest with the friction term (`_fixed_point`). Either answers to an FC3D
+        error of at most ``tol``, the measure of a contact-space problem, or fails saying where
+        it stopped. Anitescu's relaxation, one convex problem, is refused for an asymmetric
+        ``W``.
         """
         if options["method"] == "nsgs":
             self._refuse_relaxed_nsgs(options)
@@ -321,7 +323,14 @@ class Moreau(Law):
         back = np.argsort(local_order(m, d))
         G = problem.W[back][:, back].toarray()
         P, diagnostics = _fixed_point(G, problem.q[back], problem.mu, d, options)
-        return P[local_order(m, d)], diagnostics
+        r = P[local_order(m, d)]
+        error = problem.error(r)
+        if error > options["tol"]:
+            raise SolverFailure(
+                f"moreau: the fixed point settled after {diagnostics['fixed_point_steps']} cone "
+                f"QPs at FC3D error {error:.3g} on W, above the tolerance {options['tol']:g}"
+            )
+        return r, diagnostics
 
     def _resolve_batch(
         self, batch: ProblemBatch, options: dict[str, Any]

@@ -72,3 +72,16 @@ def test_a_contact_problem_is_not_an_impact_problem():
         moreau.resolve(ContactProblem(*ISOTROPIC))
     with pytest.raises(TypeError, match="must be a ContactProblem, not ImpactProblem"):
         moreau.solve_contact(lawbench.CASES["sphere_wall"].build())
+
+
+def test_a_fixed_point_that_settles_above_tol_fails_saying_where():
+    """In contact space the FC3D error is the measure: a fixed point whose shift no longer
+    changes but whose answer misses tol on W is a failure, never an answer. Frictionless, the
+    shift is zero from the start, so one cone QP settles it at rounding, above tol = 1e-300."""
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(6, 6))
+    problem = ContactProblem(A @ A.T + np.eye(6), [-1.0, 0.2, 0.1, -0.5, 0.0, 0.3], [0.0, 0.0])
+    moreau = lawbench.LAWS["moreau"]
+    assert moreau.solve_contact(problem).fc3d_error <= 1e-10
+    with pytest.raises(lawbench.SolverFailure, match=r"settled after 1 cone QPs at FC3D error"):
+        moreau.solve_contact(problem, tol=1e-300)
