@@ -220,9 +220,9 @@ class Moreau(Law):
         ),
         Spec(
             "max_steps",
-            100_000,
+            1000,
             "bound on the cone QPs of the exact Coulomb law's fixed point, or on the sweeps of "
-            "Gauss-Seidel (granular problems take thousands); max_seconds bounds either",
+            "Gauss-Seidel (granular problems take thousands: raise it for them)",
             "",
             "int",
             1,
