@@ -76,6 +76,8 @@ def test_nsgs_agrees_with_the_fixed_point_on_the_frictional_scenes(name, mu):
     np.testing.assert_allclose(nsgs, fixed_point, rtol=0, atol=1e-10 * scale)
 
 
+# Granular problems take thousands of sweeps, above Moreau's default bound.
+GRANULAR_SWEEPS = 100_000
 # Gauss-Seidel settles away from any solution on this file's singular W (tests/data/fclib).
 STALLS = "OneObject-i100000-499"
 
@@ -86,10 +88,10 @@ def test_nsgs_solves_the_committed_fclib_files(path):
     a global file solved as an impact, a local one in contact space, W as given."""
     problem = read_fclib(path)
     if isinstance(problem, lawbench.ContactProblem):
-        answer = MOREAU.solve_contact(problem, method="nsgs", tol=1e-8)
+        answer = MOREAU.solve_contact(problem, method="nsgs", tol=1e-8, max_steps=GRANULAR_SWEEPS)
         error = answer.fc3d_error
     else:
-        answer = MOREAU.resolve(problem, method="nsgs", tol=1e-8)
+        answer = MOREAU.resolve(problem, method="nsgs", tol=1e-8, max_steps=GRANULAR_SWEEPS)
         error = fclib_diagnostics(path, answer)["fc3d_error"]
     assert error <= 1e-8
     assert answer.diagnostics["formulation"].startswith("NSGS")
@@ -104,7 +106,7 @@ def test_a_stationary_iteration_on_a_singular_w_fails_naming_the_rank():
     why."""
     problem = read_fclib(next(path for path in FCLIB if path.stem == STALLS))
     with pytest.raises(SolverFailure, match=r"stationary after \d+ sweeps at FC3D error") as e:
-        MOREAU.solve_contact(problem, method="nsgs", tol=1e-8)
+        MOREAU.solve_contact(problem, method="nsgs", tol=1e-8, max_steps=GRANULAR_SWEEPS)
     assert "W is singular, rank 49 of 72" in str(e.value)
     sweeps = int(str(e.value).split("after ")[1].split(" sweeps")[0])
     assert 1000 <= sweeps <= 5000
