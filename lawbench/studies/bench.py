@@ -43,12 +43,12 @@ from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS
 from lawbench.core.outcome import Outcome
-from lawbench.core.problem import ImpactProblem, as_array
+from lawbench.core.problem import ImpactProblem
 from lawbench.core.registry import Registry
 from lawbench.core.trial import solve_batch
 from lawbench.files.fclib import fclib_form
 from lawbench.numerics.chains import chain_problem
-from lawbench.numerics.gauss_seidel import local_order
+from lawbench.numerics.gauss_seidel import in_local_order
 from lawbench.numerics.solvers import clarabel_settings, enumerate_lcp
 from lawbench.studies.guard import TIME_OUT, WALL_CLOCK, Guard, Result, alarm
 
@@ -638,9 +638,8 @@ def _as_contact_problem(problem: ImpactProblem | ContactProblem) -> ContactProbl
         return problem if problem.dim == 3 else None
     if not problem.frictional or problem.d != 2:
         return None
-    order = local_order(problem.m, problem.d)
-    W = as_array(problem.contact_delassus)[np.ix_(order, order)]
-    return ContactProblem(W, np.asarray(problem.W.T @ problem.v)[order], problem.mu, 3)
+    W, q = in_local_order(problem.contact_delassus, problem.W.T @ problem.v, problem.m, 2)
+    return ContactProblem(W, q, problem.mu, 3)
 
 
 def bench_problems(
