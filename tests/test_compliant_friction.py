@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.numerics.transforms import grazing
+from lawbench.core.transforms import grazing
 from lawbench.views import cli
 
 FRICTIONAL = [case.name for case in lawbench.CASES.values() if case.requires.friction]

@@ -286,7 +286,7 @@ def test_a_grazing_approach_under_a_fast_slip_keeps_the_friction_cone(speed):
     the friction impulse stays within mu Pn, both of order ``speed`` times a mass. The
     integrator's absolute tolerance follows the normal approach; with the slip speed's it left
     |Pt| 1.7e-4 beyond the cone at 1e-8 m/s."""
-    from lawbench.numerics.transforms import apply
+    from lawbench.core.transforms import apply
 
     problem = apply(f"grazing={speed}", lawbench.CASES.get("falling_rod").build(e=1.0))
     outcome = lawbench.LAWS.get("jia").resolve(problem)

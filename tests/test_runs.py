@@ -9,7 +9,7 @@ import pytest
 
 import lawbench
 from lawbench.checks.study import Job, Plan
-from lawbench.numerics.transforms import apply, parse, spell
+from lawbench.core.transforms import apply, parse, spell
 from lawbench.studies.grid import RunSpec, values
 from lawbench.studies.guard import Guard
 from lawbench.studies.record import budget_text

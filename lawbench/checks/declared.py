@@ -99,7 +99,7 @@ def grazing(
     """Every law on ``case`` with its approach made grazing, for each restitution of ``e``.
 
     Fastest approach at each of ``values`` (m/s; every decade from 1 to 1e-12 in the full
-    report), the motion the contacts do not see kept (`lawbench.numerics.transforms.grazing`).
+    report), the motion the contacts do not see kept (`lawbench.core.transforms.grazing`).
     """
     return extremes(
         f"{case}_grazing",

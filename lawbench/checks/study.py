@@ -3,7 +3,7 @@
 A study (laws x scenes x parameters x options x transforms) is declared where its scene or law is
 (in the module of the case or the law) and registered in `STUDIES`; the engine knows none by name.
 Its grid expands deterministically into `Job` cells (one law with options on one scene with
-parameters, optionally a named transform of the built problem, `lawbench.numerics.transforms`); the
+parameters, optionally a named transform of the built problem, `lawbench.core.transforms`); the
 executor (`lawbench.studies.runner`) runs every cell the same way and returns one tidy table whose
 rows are `lawbench.studies.record.Record` rows: the outcome, the measured columns, and the verdict
 of each named check.
@@ -114,8 +114,8 @@ class Job:
         """
         from lawbench.core.case import CASES
         from lawbench.core.law import LAWS
+        from lawbench.core.transforms import apply
         from lawbench.core.trial import Trial
-        from lawbench.numerics.transforms import apply
 
         law, case = LAWS.get(self.law), CASES.get(self.case)
         params = case.parameters(**self.params)
@@ -210,7 +210,7 @@ class Study:
     knobs : sequence of float
         When given, each law's accuracy knob is swept over these values (`knob_values`).
     transform : str or None
-        A transform of `lawbench.numerics.transforms.TRANSFORMS` applied to every cell, with each of
+        A transform of `lawbench.core.transforms.TRANSFORMS` applied to every cell, with each of
         ``transform_values``.
     transform_values : sequence of float
         The transform's values.
@@ -303,7 +303,7 @@ class Study:
         """
         from lawbench.core.case import CASES
         from lawbench.core.law import LAWS
-        from lawbench.numerics.transforms import spell
+        from lawbench.core.transforms import spell
 
         transforms = [spell(self.transform, v) for v in self.transform_values] or [""]
         for case_name in self.case_names():

@@ -1,7 +1,6 @@
 """Numerics: the methods laws share, with no law or scene in them.
 
 Owns the LCP and QP solvers and their enumerations, second-order cones (clarabel), Lemke's
-method, the event integrator and its root finder, rigid-body kinematics, chain builders, and
-the transforms of a built problem (perturbed gaps, grazing speed, a duplicated contact). May
-import `lawbench.core` only.
+method, the event integrator and its root finder, rigid-body kinematics and chain builders.
+May import `lawbench.core` only.
 """

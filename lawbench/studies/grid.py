@@ -17,7 +17,7 @@ A specification is a TOML file (or the same built from the command line)::
 
     [[grid]]
     cases = ["three_ball_chain"]
-    transforms = ["grazing=1e-08", "duplicated"]   # lawbench.numerics.transforms, one per row
+    transforms = ["grazing=1e-08", "duplicated"]   # lawbench.core.transforms, one per row
 
 A parameter or option takes a list of values, one value, ``{range = [start, stop, count]}`` (evenly
 spaced), ``{logrange = [start_exponent, stop_exponent, count]}`` (powers of ten), or ``{random =
@@ -53,8 +53,8 @@ from lawbench.checks.study import Job, Plan
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
+from lawbench.core.transforms import parse
 from lawbench.files.paths import input_file
-from lawbench.numerics.transforms import parse
 
 if TYPE_CHECKING:
     from lawbench.core.case import Case

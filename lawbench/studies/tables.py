@@ -20,7 +20,7 @@ import pandas as pd
 from lawbench.checks.declared import STUDIES
 from lawbench.checks.study import Study
 from lawbench.core.errors import InvalidProblem
-from lawbench.numerics.transforms import parse
+from lawbench.core.transforms import parse
 from lawbench.studies.guard import BUDGET_S
 from lawbench.studies.record import budget_text
 from lawbench.studies.runner import Executor, collect

@@ -32,9 +32,9 @@ from lawbench.core.errors import (
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.registry import Registry
+from lawbench.core.transforms import apply
 from lawbench.core.trial import evaluate
 from lawbench.files.paths import output_file, output_folder
-from lawbench.numerics.transforms import apply
 from lawbench.studies.guard import BUDGET_S, EXECUTORS, alarm
 from lawbench.views.serialize import contact_record, trial_record
 

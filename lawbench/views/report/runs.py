@@ -22,7 +22,7 @@ from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case
 from lawbench.core.law import LAWS, Law
 from lawbench.core.registry import Registry
-from lawbench.numerics.transforms import parse
+from lawbench.core.transforms import parse
 from lawbench.studies.runner import Executor, run_many
 from lawbench.views.report.config import Config
 
