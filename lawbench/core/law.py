@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 import time
 import warnings
 from abc import ABC, abstractmethod
@@ -167,33 +166,31 @@ class Law(ABC):
             problem = problem.dense()
         units = problem.units if self.scale_free else (1.0, 1.0, 1.0)
         solved = problem if units == (1.0, 1.0, 1.0) else problem.in_units(*units)
-        start = time.perf_counter()
-        with budget.Budget.of(self.name, values), warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            if solved.closed_count == solved.m or self.follows_gaps:
-                outcome = self._resolve(solved, values)
-            elif solved.closed_count:
-                closed = solved.closed
-                outcome = _embed(
-                    self._resolve(solved.select_contacts(closed), values), closed, solved
-                )
-            else:
-                outcome = Outcome.from_impulses(solved, np.zeros(solved.m))
-                outcome.diagnostics["formulation"] = "no closed contact"
-        wall_time = time.perf_counter() - start
+        with _Watch(self.name, values) as watch:
+            outcome = self._resolve_closed(solved, values)
         if solved is not problem:
             outcome = _scaled_back(outcome, problem, units)
         if problem.Wt is not None and outcome.Pt.size == 0:
             outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
-        _refuse_non_finite(self.name, outcome)
+        _refuse_non_finite(
+            self.name, v_plus=outcome.v_plus, Pn=outcome.Pn, Pt=outcome.Pt, T_plus=outcome.T_plus
+        )
         outcome.diagnostics["options"] = values
         if separating:
             outcome.diagnostics["separating_contacts"] = list(separating)
             outcome.diagnostics["separating_rule"] = rule
-        outcome.diagnostics["wall_time_s"] = wall_time
-        heard = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
-        if heard:
-            outcome.diagnostics["warnings"] = heard
+        outcome.diagnostics.update(watch.record)
+        return outcome
+
+    def _resolve_closed(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        """`_resolve` on the closed contacts only (all of them for a law that follows gaps)."""
+        if problem.closed_count == problem.m or self.follows_gaps:
+            return self._resolve(problem, options)
+        if problem.closed_count:
+            closed = problem.closed
+            return _embed(self._resolve(problem.select_contacts(closed), options), closed, problem)
+        outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
+        outcome.diagnostics["formulation"] = "no closed contact"
         return outcome
 
     @abstractmethod
@@ -240,17 +237,10 @@ class Law(ABC):
                 f"{self.name}: resolves impacts in generalized coordinates; a contact-space "
                 "problem (FCLIB's local form: W, q and mu only) has none"
             )
-        start = time.perf_counter()
-        with budget.Budget.of(self.name, values), warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with _Watch(self.name, values) as watch:
             r, diagnostics = self._solve_contact(problem, values)
-        wall_time = time.perf_counter() - start
-        if not all_finite(r):
-            raise SolverFailure(f"{self.name}: non-finite impulses {r}")
-        heard = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
-        diagnostics.update(options=values, wall_time_s=wall_time, W_asymmetry=problem.asymmetry)
-        if heard:
-            diagnostics["warnings"] = heard
+        _refuse_non_finite(self.name, r=r)
+        diagnostics.update(watch.record, W_asymmetry=problem.asymmetry)
         return ContactSolution(r, problem.velocity(r), problem.error(r), diagnostics)
 
     def _solve_contact(
@@ -282,25 +272,23 @@ class Law(ABC):
         from lawbench.core.batch import OutcomeBatch  # on first use: a single solve needs no batch
 
         values = self.option_values(options)
-        start = time.perf_counter()
         # Problems of extreme scale are rescaled one by one, by `resolve`.
         scaled = self.scale_free and not batch.in_own_units
-        Pn = None if scaled else self._resolve_batch(batch, values)
-        if Pn is not None:
-            formulation = Pn[1]
-            result = OutcomeBatch.from_impulses(batch, Pn[0], formulation=formulation)
-        else:
-            outcomes = [self.resolve(batch.problem(k), **values) for k in range(len(batch))]
-            result = OutcomeBatch(
-                np.stack([o.v_plus for o in outcomes]),
-                np.stack([o.Pn for o in outcomes]),
-                np.array([o.T_minus for o in outcomes]),
-                np.array([o.T_plus for o in outcomes]),
-                {"formulation": "one by one"},
-            )
-        if not np.isfinite(result.v_plus).all():
-            raise SolverFailure(f"{self.name}: non-finite v_plus in a batch")
-        result.diagnostics.update(options=values, wall_time_s=time.perf_counter() - start)
+        with _Watch(self.name, values) as watch:
+            Pn = None if scaled else self._resolve_batch(batch, values)
+            if Pn is not None:
+                result = OutcomeBatch.from_impulses(batch, Pn[0], formulation=Pn[1])
+            else:
+                outcomes = [self.resolve(batch.problem(k), **values) for k in range(len(batch))]
+                result = OutcomeBatch(
+                    np.stack([o.v_plus for o in outcomes]),
+                    np.stack([o.Pn for o in outcomes]),
+                    np.array([o.T_minus for o in outcomes]),
+                    np.array([o.T_plus for o in outcomes]),
+                    {"formulation": "one by one"},
+                )
+        _refuse_non_finite(self.name, v_plus=result.v_plus)
+        result.diagnostics.update(watch.record)
         return result
 
     def _resolve_batch(
@@ -313,18 +301,40 @@ class Law(ABC):
         return None
 
 
-def _refuse_non_finite(name: str, outcome: Outcome) -> None:
-    """Raise `SolverFailure` naming the first field of ``outcome`` with a non-finite number."""
-    if (
-        math.isfinite(outcome.T_plus)
-        and all_finite(outcome.v_plus)
-        and all_finite(outcome.Pn)
-        and all_finite(outcome.Pt)
-    ):
-        return
-    for field in ("v_plus", "Pn", "Pt", "T_plus"):
-        if not all_finite(np.asarray(getattr(outcome, field))):
-            raise SolverFailure(f"{name}: non-finite {field} {getattr(outcome, field)}")
+class _Watch:
+    """What every solve shares: its budget, its wall time, and the warnings it raised.
+
+    Opened around a law's own solve, it opens the `budget.Budget` the checked ``options`` set
+    and records every warning instead of printing it. ``record`` then holds ``options``,
+    ``wall_time_s`` and, where the solve raised any, ``warnings``, for the answer's diagnostics.
+    """
+
+    def __init__(self, law: str, options: dict[str, Any]) -> None:
+        self.budget = budget.Budget.of(law, options)
+        self.warnings = warnings.catch_warnings(record=True)
+        self.record: dict[str, Any] = {"options": options}
+
+    def __enter__(self) -> _Watch:
+        self.budget.__enter__()
+        self.caught = self.warnings.__enter__()
+        warnings.simplefilter("always")
+        self.start = time.perf_counter()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.record["wall_time_s"] = time.perf_counter() - self.start
+        self.warnings.__exit__(*exc)
+        self.budget.__exit__(*exc)
+        heard = sorted({f"{w.category.__name__}: {w.message}" for w in self.caught})
+        if heard:
+            self.record["warnings"] = heard
+
+
+def _refuse_non_finite(name: str, **fields: Any) -> None:
+    """Raise `SolverFailure` naming the first of ``fields`` that holds a non-finite number."""
+    for field, value in fields.items():
+        if not all_finite(np.asarray(value, dtype=float)):
+            raise SolverFailure(f"{name}: non-finite {field} {value}")
 
 
 def _scaled_back(

@@ -1,24 +1,40 @@
-"""A law solved on a scene or a problem: the `Trial`, and the entry points that make one.
+"""A law solved on a scene or a problem: the `Trial`, and the one way into every solve.
 
-`solve`, `evaluate` and `solve_batch` take a law (a registered name or a `Law`) and a scene (a
-registered name or a `Case`) or an `ImpactProblem`; a scene's parameters follow as keywords,
-the law's options as ``options``. Everything a check reads is in the trial.
+`make_trial` is that way: it takes a law (a registered name or a `Law`) and any source of a
+problem (a scene with its parameters, an `ImpactProblem`, a `ContactProblem`, a `ProblemBatch`,
+or anything that carries a ``problem`` with what was learned while obtaining it, such as a
+problem file as read), checks the parameters once, builds the scene once, applies a named
+transform (`lawbench.core.transforms`), and solves under the law's budget. The command line,
+the study runner, the checks, the batch API and the bench call it; `solve`, `evaluate` and
+`solve_batch` are its public faces. Everything a check reads is in the trial.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from lawbench.core.case import CASES, Case
+from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
+from lawbench.core.transforms import apply
 
 if TYPE_CHECKING:
     from lawbench.core.batch import OutcomeBatch, ProblemBatch
+
+
+class Carried(Protocol):
+    """A problem with what was learned while obtaining it (a file as read, a measurement)."""
+
+    problem: ImpactProblem | ContactProblem
+    facts: Mapping[str, Any]
+
+
+Source = str | Case | ImpactProblem | ContactProblem | Carried
 
 
 @dataclass(frozen=True)
@@ -26,17 +42,20 @@ class Trial:
     """One law solved on one problem: everything a check may read.
 
     ``case`` and ``params`` are the scene and its complete parameters when the problem was
-    built from a registered scene; None and empty for a problem given as it is.
+    built from a registered scene; None and empty for a problem given as it is (or transformed).
+    A contact-space problem's answer is a `ContactSolution`, a batch's an `OutcomeBatch`.
     """
 
     law: Law
     case: Case | None
     params: dict[str, Any]
     options: dict[str, Any]
-    problem: ImpactProblem
-    outcome: Outcome
+    problem: ImpactProblem | ContactProblem | ProblemBatch
+    outcome: Outcome | ContactSolution | OutcomeBatch
     # Settings of the checks that solve again (for example continuity's perturbation sizes).
     settings: dict[str, Any] = field(default_factory=dict)
+    # What was learned while obtaining the problem (a file's form, storage, rank).
+    facts: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def scene(self) -> str:
@@ -108,25 +127,94 @@ def evaluate(
     >>> trial.outcome.v_plus.tolist(), str(lawbench.run_checks(trial)["energy_gain"].verdict)
     ([0.0, 1.0], 'holds')
     """
-    law, given = _law(law), _options(options)
-    if isinstance(case, ImpactProblem):
-        if params:
-            raise InvalidProblem(
-                f"scene parameters {sorted(params)} given with a problem: a problem is solved "
-                "as it is"
-            )
-        scene, full, problem = None, {}, case
-    elif isinstance(case, str | Case):
-        scene = CASES.get(case)
-        full = scene.parameters(**params)
+    return make_trial(law, case, params=params, options=_options(options))
+
+
+def make_trial(
+    law: str | Law,
+    source: Source | ProblemBatch,
+    *,
+    params: Mapping[str, Any] | None = None,
+    options: Mapping[str, Any] | None = None,
+    transform: str = "",
+    settings: Mapping[str, Any] | None = None,
+) -> Trial:
+    """Solve ``source`` with ``law``: the one way into every solve.
+
+    Parameters
+    ----------
+    law : str or Law
+        A registered law name or a law object.
+    source : str, Case, ImpactProblem, ContactProblem, ProblemBatch, or a carried problem
+        A scene (its parameters in ``params``), a problem given as it is, or an object with a
+        ``problem`` and the ``facts`` learned while obtaining it.
+    params : mapping, optional
+        The scene's parameters, checked once; the others take their defaults.
+    options : mapping, optional
+        The law's options, checked once by the law.
+    transform : str
+        A named transform of the built impact problem (``grazing=1e-08``), '' for none.
+    settings : mapping, optional
+        Settings of the checks that solve again, carried by the trial.
+
+    Returns
+    -------
+    Trial
+
+    Raises
+    ------
+    InvalidProblem
+        An unknown law, scene, parameter, option or transform, a bad value, or parameters or a
+        transform given with a source that takes none.
+    NotApplicable, SolverFailure
+        As the law's solve raises them.
+    """
+    law = _law(law)
+    options, facts, scene, full = dict(options or {}), {}, None, {}
+    if hasattr(source, "facts"):
+        source, facts = source.problem, dict(source.facts)
+    if isinstance(source, str | Case):
+        scene = CASES.get(source)
+        full = scene.parameters(**(params or {}))
         problem = scene.build(**full)
-    else:
-        raise TypeError(
-            "case must be a scene name (str), a Case or an ImpactProblem, not "
-            f"{type(case).__name__}"
+    elif params:
+        raise InvalidProblem(
+            f"scene parameters {sorted(params)} given with a problem: a problem is solved as it is"
         )
-    outcome = law.resolve(problem, **given)
-    return Trial(law, scene, full, outcome.diagnostics["options"], problem, outcome)
+    else:
+        problem = source
+    if transform:
+        problem = _transformed(transform, problem)
+        scene, full = None, {}
+    outcome = _answer(law, problem, options)
+    values = outcome.diagnostics["options"]
+    return Trial(law, scene, full, values, problem, outcome, dict(settings or {}), facts)
+
+
+def _transformed(transform: str, problem: object) -> ImpactProblem:
+    """The impact ``problem`` changed by the named ``transform``."""
+    if not isinstance(problem, ImpactProblem):
+        raise InvalidProblem(
+            f"transform {transform!r} changes an impact problem, not a {type(problem).__name__}"
+        )
+    return apply(transform, problem)
+
+
+def _answer(
+    law: Law, problem: object, options: dict[str, Any]
+) -> Outcome | ContactSolution | OutcomeBatch:
+    """The law's answer to ``problem``, by the method that treats its kind."""
+    if isinstance(problem, ImpactProblem):
+        return law.resolve(problem, **options)
+    if isinstance(problem, ContactProblem):
+        return law.solve_contact(problem, **options)
+    from lawbench.core.batch import ProblemBatch  # here: a single solve needs no batch
+
+    if isinstance(problem, ProblemBatch):
+        return law.resolve_batch(problem, **options)
+    raise TypeError(
+        f"case must be a scene name (str), a Case or an ImpactProblem, not {type(problem).__name__}"
+    )
 
 
 def solve_batch(
@@ -161,10 +249,10 @@ def solve_batch(
     """
     from lawbench.core.batch import ProblemBatch  # on first use: a single solve needs no batch
 
-    law = _law(law)
     if not isinstance(batch, ProblemBatch):
+        _law(law)
         batch = ProblemBatch.from_problems(list(batch))
-    return law.resolve_batch(batch, **_options(options))
+    return make_trial(law, batch, options=_options(options)).outcome
 
 
 def _law(law: object) -> Law:
