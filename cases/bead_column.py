@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from lawbench.cases import _specs
 from lawbench.cases._chains import SPRINGS
 from lawbench.checks.declared import STUDIES, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, per_item
@@ -47,9 +48,7 @@ class BeadColumn(Case):
     summary = "a column of steel beads dropped onto a wall (Falcon et al. 1998)"
     params = (
         Spec("n", 10, "number of beads", "", "int", 1, 1000),
-        Spec(
-            "drop_height", 3.1e-3, "height the column falls from", "m", "float", 0.0, low_open=True
-        ),
+        _specs.positive("drop_height", 3.1e-3, "height the column falls from", "m"),
         restitution_spec(),
     )
     requires = Tags(several_contacts=True, stiffness=True)

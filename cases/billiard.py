@@ -40,6 +40,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import STUDIES, speed_accuracy
 from lawbench.checks.study import Study
@@ -108,10 +109,10 @@ class Billiard(Case):
     name = "billiard"
     summary = "cue striking a billiard ball on the table: two frictional contacts (Jia 2013)"
     params = (
-        Spec("mass", 0.17, "ball mass", "kg", "float", 0.0, low_open=True),
-        Spec("radius", 0.028575, "ball radius", "m", "float", 0.0, low_open=True),
-        Spec("cue_mass", 0.54, "cue mass", "kg", "float", 0.0, low_open=True),
-        Spec("speed", 3.0, "cue speed along its axis", "m/s", "float", 0.0, low_open=True),
+        _specs.mass(0.17, "ball mass"),
+        _specs.positive("radius", 0.028575, "ball radius", "m"),
+        _specs.positive("cue_mass", 0.54, "cue mass", "kg"),
+        _specs.positive("speed", 3.0, "cue speed along its axis", "m/s"),
         Spec("elevation", 0.0, "cue elevation above the table", "deg", "float", 0.0, 89.0),
         Spec("offset_side", 0.0, "sideways offset of the cue's axis (english)", "m", "float"),
         Spec(
@@ -121,8 +122,8 @@ class Billiard(Case):
             "m",
             "float",
         ),
-        Spec("e", [0.8, 0.5], "restitution, cue-ball then ball-table", "", "floats", 0.0, 1.0),
-        Spec("mu", [0.6, 0.2], "friction, cue-ball then ball-table", "", "floats", 0.0),
+        _specs.restitution([0.8, 0.5], "restitution, cue-ball then ball-table"),
+        _specs.friction([0.6, 0.2], "friction, cue-ball then ball-table"),
         stiffness_ratio_spec("stiffness of the ball-table contact over the cue-ball one"),
         exponent_spec(),
     )

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import STUDIES, large_friction, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, Reference, exactly
@@ -134,8 +135,8 @@ def vector_spec(name: str, default: list[float], doc: str, unit: str) -> Spec:
 def contact_specs(e: float, mu: float, ratio: float) -> tuple[Spec, ...]:
     """The contact parameters ``e``, ``mu`` and ``tangential_stiffness_ratio``."""
     return (
-        Spec("e", e, "energetic restitution coefficient", "", "float", 0.0, 1.0),
-        Spec("mu", mu, "Coulomb friction coefficient", "", "float", 0.0),
+        _specs.restitution(e, "energetic restitution coefficient"),
+        _specs.friction(mu),
         Spec(
             "tangential_stiffness_ratio",
             ratio,
@@ -156,8 +157,8 @@ class BouncingBall(Case):
     params = (
         vector_spec("velocity", [1.0, 0.0, -5.0], "velocity of the centre before impact", "m/s"),
         vector_spec("angular_velocity", [0.0, 2.0, 0.0], "angular velocity before impact", "rad/s"),
-        Spec("radius", 1.0, "radius of the ball", "m", "float", 0.0, low_open=True),
-        Spec("mass", 1.0, "mass of the ball", "kg", "float", 0.0, low_open=True),
+        _specs.positive("radius", 1.0, "radius of the ball", "m"),
+        _specs.mass(1.0, "mass of the ball"),
         *contact_specs(0.5, 0.4, MINDLIN_RATIO),
     )
     requires = Tags(friction=True, spatial=True)

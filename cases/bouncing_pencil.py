@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases.bouncing_ball import (
     COORDINATES,
     TANGENTIAL_COMPLIANCE,
@@ -86,28 +87,10 @@ class BouncingPencil(Case):
             "m/s",
         ),
         vector_spec("angular_velocity", [1.0, 0.5, 0.5], "angular velocity before impact", "rad/s"),
-        Spec("mass", 1.0, "mass of the pencil", "kg", "float", 0.0, low_open=True),
-        Spec(
-            "radius",
-            1.0,
-            "radius of the cylinder and the cone's base",
-            "m",
-            "float",
-            0.0,
-            low_open=True,
-        ),
-        Spec(
-            "cylinder_length", 3.0, "length of the cylinder (h1)", "m", "float", 0.0, low_open=True
-        ),
-        Spec(
-            "cone_height",
-            0.5,
-            "height of the cone at the tip (h2)",
-            "m",
-            "float",
-            0.0,
-            low_open=True,
-        ),
+        _specs.mass(1.0, "mass of the pencil"),
+        _specs.positive("radius", 1.0, "radius of the cylinder and the cone's base", "m"),
+        _specs.positive("cylinder_length", 3.0, "length of the cylinder (h1)", "m"),
+        _specs.positive("cone_height", 0.5, "height of the cone at the tip (h2)", "m"),
         Spec(
             "tilt",
             60.0,

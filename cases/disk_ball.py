@@ -49,6 +49,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import STUDIES, impact_paths, speed_accuracy
 from lawbench.checks.study import Study
@@ -98,19 +99,11 @@ class DiskBall(Case):
     summary = "ball striking a disk standing on a rough floor (Zhang, Liu, Zhao, Brogliato 2013)"
     params = (
         Spec("b", 0.02, "impact height above the disk's centre, on its axis", "m", "float"),
-        Spec("vb", 1.0, "ball speed towards the disk", "m/s", "float", 0.0, low_open=True),
-        Spec("radius", 0.05, "disk radius r", "m", "float", 0.0, low_open=True),
-        Spec(
-            "half_thickness",
-            0.005,
-            "half the disk's thickness, h",
-            "m",
-            "float",
-            0.0,
-            low_open=True,
-        ),
-        Spec("disk_mass", 0.5, "disk mass md", "kg", "float", 0.0, low_open=True),
-        Spec("ball_mass", 0.02, "ball mass mb", "kg", "float", 0.0, low_open=True),
+        _specs.positive("vb", 1.0, "ball speed towards the disk", "m/s"),
+        _specs.positive("radius", 0.05, "disk radius r", "m"),
+        _specs.positive("half_thickness", 0.005, "half the disk's thickness, h", "m"),
+        _specs.positive("disk_mass", 0.5, "disk mass md", "kg"),
+        _specs.positive("ball_mass", 0.02, "ball mass mb", "kg"),
         Spec("mu_floor", 0.3, "Coulomb friction at the floor points A, B, C", "", "float", 0.0),
         Spec("mu_ball", 0.2, "Coulomb friction between ball and disk (D)", "", "float", 0.0),
         Spec(

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import STUDIES, energy_map, large_friction, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, exactly
@@ -97,8 +98,8 @@ class DoublePendulum(Case):
             "rad/s",
             "floats",
         ),
-        Spec("e", 0.9, "Newton's restitution coefficient", "", "float", 0.0, 1.0),
-        Spec("mu", 0.5, "Coulomb friction coefficient", "", "float", 0.0),
+        _specs.restitution(0.9),
+        _specs.friction(0.5),
     )
     requires = Tags(friction=True)
     ground_truth = springs_with_friction(

@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import (
     STUDIES,
@@ -165,8 +166,8 @@ class FallingRod(Case):
     name = "falling_rod"
     summary = "rod striking a rough floor with one end (Brogliato 2010, eqs. 7-9)"
     params = (
-        Spec("length", 1.0, "length of the whole rod", "m", "float", 0.0, low_open=True),
-        Spec("mass", 1.0, "rod mass", "kg", "float", 0.0, low_open=True),
+        _specs.positive("length", 1.0, "length of the whole rod", "m"),
+        _specs.mass(1.0, "rod mass"),
         Spec(
             "angle",
             45.0,
@@ -184,8 +185,8 @@ class FallingRod(Case):
             "m/s, m/s, rad/s",
             "floats",
         ),
-        Spec("e", 0.5, "Newton's restitution coefficient", "", "float", 0.0, 1.0),
-        Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
+        _specs.restitution(0.5),
+        _specs.friction(0.3),
     )
     requires = Tags(friction=True)
     ground_truth = springs_with_friction(

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import (
     STUDIES,
@@ -118,7 +119,7 @@ class Lamina(Case):
             low=0.0,
             high=1.0,
         ),
-        Spec("mu", 0.5, "Coulomb friction coefficient", "", low=0.0),
+        _specs.friction(0.5),
     )
     requires = Tags(friction=True)
     ground_truth = springs_with_friction(

@@ -45,11 +45,11 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.checks.declared import STUDIES, large_friction, speed_accuracy
 from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, GroundTruth, Params, Reference
 from lawbench.core.problem import Contact, ImpactProblem
-from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.core.trial import Trial
 from lawbench.numerics.rigid import planar_column, planar_tangent
@@ -121,21 +121,18 @@ class RockingBlock(Case):
     name = "rocking_block"
     summary = "rectangular block landing on its other corner (Housner 1963; Brogliato 2010)"
     params = (
-        Spec("width", 0.5, "block width (L in the lectures)", "m", "float", 0.0, low_open=True),
-        Spec("height", 1.0, "block height (l in the lectures)", "m", "float", 0.0, low_open=True),
-        Spec("mass", 10.0, "block mass", "kg", "float", 0.0, low_open=True),
-        Spec(
+        _specs.positive("width", 0.5, "block width (L in the lectures)", "m"),
+        _specs.positive("height", 1.0, "block height (l in the lectures)", "m"),
+        _specs.mass(10.0, "block mass"),
+        _specs.positive(
             "omega",
             1.0,
             "pre-impact angular velocity about the right (pivot) corner, counter-clockwise: "
             "the left corner comes down",
             "rad/s",
-            "float",
-            0.0,
-            low_open=True,
         ),
-        Spec("e", 0.0, "Newton's restitution coefficient of both corners", "", "float", 0.0, 1.0),
-        Spec("mu", 0.5, "Coulomb friction coefficient of both corners", "", "float", 0.0),
+        _specs.restitution(0.0, "Newton's restitution coefficient of both corners"),
+        _specs.friction(0.5, "Coulomb friction coefficient of both corners"),
     )
     requires = Tags(friction=True, several_contacts=True)
     ground_truth = GroundTruth(

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
 from lawbench.checks.declared import STUDIES, grazing, large_friction, speed_accuracy
 from lawbench.checks.study import Study
@@ -73,8 +74,8 @@ class SphereWall(Case):
     name = "sphere_wall"
     summary = "spinning sphere striking a rough wall obliquely (spatial)"
     params = (
-        Spec("radius", 0.1, "sphere radius", "m", "float", 0.0, low_open=True),
-        Spec("mass", 1.0, "sphere mass", "kg", "float", 0.0, low_open=True),
+        _specs.positive("radius", 0.1, "sphere radius", "m"),
+        _specs.mass(1.0, "sphere mass"),
         Spec(
             "angle",
             45.0,
@@ -84,19 +85,11 @@ class SphereWall(Case):
             0.0,
             90.0,
         ),
-        Spec(
-            "speed",
-            2.0,
-            "speed of the centre before the impact",
-            "m/s",
-            "float",
-            0.0,
-            low_open=True,
-        ),
+        _specs.positive("speed", 2.0, "speed of the centre before the impact", "m/s"),
         Spec(
             "spin", [5.0, 2.0, -10.0], "pre-impact angular velocity wx, wy, wz", "rad/s", "floats"
         ),
-        Spec("e", 0.8, "Newton's restitution coefficient", "", "float", 0.0, 1.0),
+        _specs.restitution(0.8),
         Spec(
             "e_t",
             0.2,
@@ -106,7 +99,7 @@ class SphereWall(Case):
             -1.0,
             1.0,
         ),
-        Spec("mu", 0.3, "Coulomb friction coefficient", "", "float", 0.0),
+        _specs.friction(0.3),
     )
     requires = Tags(friction=True, spatial=True)
     ground_truth = springs_with_friction("on the sphere the slip direction turns during the impact")

@@ -5,6 +5,7 @@ A law lists the ones that apply to it in its ``findings`` (`lawbench.core.verdic
 
 from lawbench.checks.regions import (
     EVERYWHERE,
+    coupled_friction,
     dissipative_contacts,
     oblique_contacts,
     recompressed_contact,
@@ -56,6 +57,18 @@ ENERGETIC_DISSIPATION = Claim(
     "e = 0.950043, 0.846529, k2/k1 = 3: jia v+ = (1.057, 0.551) v0, compliant Hunt-Crossley "
     "(1.160, 0.433) v0, Kelvin-Voigt (1.192, 0.463) v0; all three agree at e = 1)",
     (("ping_pong", "default"),),
+)
+
+
+SLIP_REVERSAL_GAIN = Claim(
+    "energy_gain",
+    coupled_friction,
+    "Kane and Levinson 1985; Brogliato 2010, eqs. (6)-(9)",
+    "kinematic restitution with Coulomb friction on the post-impact slip (at one contact "
+    "Whittaker's law, Brogliato 2010 eq. 8): inertial coupling reverses the slip during the "
+    "impact, and dT = -e Pn un- - mu Pn |ut+| - P.G P / 2 is then positive for e close to 1 "
+    "(Kane and Levinson's paradox)",
+    (("falling_rod", "energy gain"), ("double_pendulum", "default")),
 )
 
 

@@ -115,7 +115,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import scipy.sparse
 
-from lawbench.checks.regions import coupled_friction, option, separating_contact
+from lawbench.checks.regions import option, separating_contact
 from lawbench.core import budget
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
@@ -129,6 +129,7 @@ from lawbench.core.verdicts import Claim
 from lawbench.laws._claims import (
     PAOLI_DISCONTINUITY,
     RIGID_DISPERSION,
+    SLIP_REVERSAL_GAIN,
     keeps_energy,
     separating_held,
 )
@@ -145,13 +146,6 @@ from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, project_on
 
 if TYPE_CHECKING:
     from lawbench.core.batch import ProblemBatch
-
-_SLIP_REVERSAL = (
-    "kinematic restitution with Coulomb friction on the post-impact slip (at one contact "
-    "Whittaker's law, Brogliato 2010 eq. 8): the slip reverses during the impact and "
-    "dT = -e Pn un- - mu Pn |ut+| - P.G P / 2 is positive for e close to 1 with strong "
-    "normal-tangential coupling"
-)
 
 
 class Moreau(Law):
@@ -241,13 +235,7 @@ class Moreau(Law):
             "the cone projection restitutes the separating contact's rate too, and can leave it "
             "approaching after the impact",
         ),
-        Claim(
-            "energy_gain",
-            coupled_friction,
-            "Kane and Levinson 1985; Brogliato 2010, eq. (8)",
-            _SLIP_REVERSAL,
-            (("falling_rod", "energy gain"), ("double_pendulum", "default")),
-        ),
+        SLIP_REVERSAL_GAIN,
     )
     guarantees = (
         keeps_energy(

@@ -77,17 +77,16 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
-from lawbench.checks.regions import coupled_friction
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import is_diagonal, kinetic_energy
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags
-from lawbench.core.verdicts import Claim
 from lawbench.laws._claims import (
     PAOLI_DISCONTINUITY,
     RIGID_DISPERSION,
+    SLIP_REVERSAL_GAIN,
     keeps_energy,
     separating_held,
 )
@@ -382,15 +381,6 @@ def _lemke_planar(setup: _Setup) -> tuple[np.ndarray | None, dict[str, Any]]:
     return np.concatenate([z[:m], z[m : 2 * m] - z[2 * m : 3 * m]]), {"pivots": result.pivots}
 
 
-# Kane and Levinson's paradox (Brogliato 2010, after eq. 9): the impulse-level Coulomb law with
-# Newton's coefficient creates energy when inertial coupling reverses the slip.
-_SLIP_REVERSAL = (
-    "inertial coupling reverses the slip during the impact; with Newton's coefficient and "
-    "Coulomb friction at the impulse level the energy change can then be positive (Kane and "
-    "Levinson's paradox): +1.5 % on the rod, +11.3 % on the double pendulum"
-)
-
-
 class Whittaker(Law):
     """Newton's normal law with Coulomb friction on the impulses, implicit in the slip."""
 
@@ -411,13 +401,7 @@ class Whittaker(Law):
         RIGID_DISPERSION,
         separating_held("energy_gain"),
         separating_held("energy_kept"),
-        Claim(
-            "energy_gain",
-            coupled_friction,
-            "Kane and Levinson 1985; Brogliato 2010, eqs. (6)-(9)",
-            _SLIP_REVERSAL,
-            (("falling_rod", "energy gain"), ("double_pendulum", "default")),
-        ),
+        SLIP_REVERSAL_GAIN,
     )
     guarantees = (
         keeps_energy(
