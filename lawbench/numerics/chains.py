@@ -34,7 +34,7 @@ def chain_problem(
 
     Parameters
     ----------
-    masses, velocities : sequences of n floats
+    masses, velocities : sequences of one float per ball
         Ball masses (kg) and velocities (m/s, positive to the right).
     pairs : sequence of m (left, right) pairs
         Ball indices, or None for a fixed wall on that side.
@@ -43,18 +43,17 @@ def chain_problem(
     gaps : sequence of m floats, optional
         Initial gaps (m); zero by default.
     """
-    n = len(masses)
     M, Wn = _mass_and_normals(np.asarray(masses, dtype=float), pairs)
     contacts = [
-        Contact(e=e, stiffness=k, exponent=n)
-        for e, k, n in zip(restitution, stiffness, exponents, strict=True)
+        Contact(e=e, stiffness=k, exponent=exponent)
+        for e, k, exponent in zip(restitution, stiffness, exponents, strict=True)
     ]
     return ImpactProblem(
         M=M,
         Wn=Wn,
         v=np.asarray(velocities, dtype=float),
         contacts=contacts,
-        bodies={f"ball {i + 1}": (i,) for i in range(n)},
+        bodies={f"ball {i + 1}": (i,) for i in range(len(masses))},
         gaps=None if gaps is None else np.asarray(gaps, dtype=float),
     )
 
@@ -79,9 +78,9 @@ def _mass_and_normals(masses: np.ndarray, pairs: Sequence[Pair]) -> tuple[Any, A
     return scipy.sparse.diags_array(masses, format="csc"), Wn
 
 
-def ball_velocities(n: int) -> list[str]:
-    """Coordinate names of n balls."""
-    return [f"v{i + 1} [m/s]" for i in range(n)]
+def ball_velocities(balls: int) -> list[str]:
+    """Coordinate names of a chain of ``balls`` balls."""
+    return [f"v{i + 1} [m/s]" for i in range(balls)]
 
 
 def masses_spec(default: list[float]) -> Spec:
