@@ -11,7 +11,7 @@ Single-solve checks read one trial (a law solved on a case): ``energy_gain``, ``
 runs them by default. ``continuity`` and ``dispersion`` solve the case again and run on request.
 """
 
-from lawbench.checks import continuity, dispersion, outcome_checks, reference
+from lawbench.checks import continuity, dispersion, outcome_checks
 from lawbench.checks.base import CHECKS, SINGLE_SOLVE, CheckResult, CheckResults, run_checks
 
 __all__ = [
@@ -22,6 +22,5 @@ __all__ = [
     "continuity",
     "dispersion",
     "outcome_checks",
-    "reference",
     "run_checks",
 ]

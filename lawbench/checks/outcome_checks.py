@@ -1,4 +1,4 @@
-"""Checks that read one outcome: energy, admissibility, impulse sign, friction, momentum."""
+"""Checks that read one trial: energy, admissibility, impulses, friction, momentum, references."""
 
 from __future__ import annotations
 
@@ -9,6 +9,8 @@ from lawbench.core.mechanics import gap_rates
 from lawbench.core.problem import RESTITUTION_FIELDS, is_sparse
 from lawbench.core.trial import Trial
 
+# References are closed forms; the laws they describe are exact up to solver polishing.
+REFERENCE_TOLERANCE = 1e-8
 # Rounding allowed on a gap rate, relative to the sum of the velocities it is the difference of.
 ROUNDING = 1e3 * float(np.finfo(float).eps)
 
@@ -144,3 +146,25 @@ def momentum(trial: Trial) -> tuple:
     value = float(np.abs(change).max()) / _scale(M @ v)
     passed = value <= TOLERANCE
     return value, passed, f"momentum change {np.abs(change).max():.3g} kg m/s"
+
+
+@check("reference", promised=True)
+def reference(trial: Trial) -> tuple:
+    """Largest error of ``v_plus`` against every reference that describes this run."""
+    if trial.case is None:
+        return None, None, "a problem given as it is has no references"
+    errors, reasons = {}, []
+    scale = max(float(np.abs(trial.problem.v).max()), 1e-300)
+    for ref in trial.case.references:
+        reason = ref.applies(trial.law.name, trial.outcome.diagnostics["options"], trial.params)
+        if reason:
+            reasons.append(f"{ref.name}: {reason}")
+            continue
+        expected = np.asarray(ref.v_plus(trial.params), dtype=float)
+        errors[ref.name] = float(np.abs(trial.outcome.v_plus - expected).max()) / scale
+    if not errors:
+        return None, None, "no reference applies" + (f" ({'; '.join(reasons)})" if reasons else "")
+    worst = max(errors, key=errors.get)
+    passed = errors[worst] <= REFERENCE_TOLERANCE
+    sources = ", ".join(f"{name} ({error:.2g})" for name, error in errors.items())
+    return errors[worst], passed, f"relative error against {sources}"
