@@ -12,6 +12,12 @@ Both are solved exactly, as non-negative least squares (Lawson-Hanson active set
 expansion problem is degenerate (every contact that ended compression closed has ``uc = 0``),
 where an interior-point method loses accuracy.
 
+Redundant contacts (normals dependent in the kinetic metric: ``G`` singular on the contacts
+that end compression closed) share the compression impulse in a way the law leaves open. The
+velocity after compression is unique, and so is the outcome when the coefficients of the
+redundant contacts are equal (a contact given twice); when they differ, the outcome depends on
+the split, and the law refuses the problem (`NotApplicable`) instead of picking one.
+
 Conventions: ``un < 0`` approaches, ``Pn >= 0`` pushes apart. The outcome is admissible
 (``un+ >= 0``) with non-negative impulses by construction. A closed contact already separating
 before the impact receives nothing in compression unless the others push it, and in expansion
@@ -23,8 +29,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import scipy.linalg
 
 from lawbench.checks.regions import separating_contact
+from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
@@ -72,6 +80,7 @@ class Poisson(Law):
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         G, e = problem.delassus, problem.restitution("kinetic")
         compression = solve_lcp(G, problem.un, method="nnls")
+        _refuse_open_split(G, e, compression.w)
         restitution = e * compression.z
         expansion = solve_lcp(G, compression.w + G @ restitution, method="nnls")
         Pn = compression.z + restitution + expansion.z
@@ -88,6 +97,8 @@ class Poisson(Law):
         if batch.m > ENUMERATION_MAX:
             return None
         G, e = batch.delassus, batch.restitution("kinetic")
+        if (np.linalg.eigvalsh(G)[:, 0] <= SINGULAR * np.abs(G).max(axis=(1, 2))).any():
+            return None  # redundant contacts: one by one, where the law decides or refuses
         compression, found = enumerate_lcp(G, batch.un)
         slack = np.einsum("kij,kj->ki", G, compression) + batch.un
         restitution = e * compression
@@ -95,6 +106,33 @@ class Poisson(Law):
         if not (found.all() and found_too.all()):
             return None
         return compression + restitution + expansion, "compression and expansion LCPs (batch)"
+
+
+# Relative size below which an eigenvalue of G, or a velocity change, is rounding.
+SINGULAR = 1e-10
+
+
+def _refuse_open_split(G: np.ndarray, e: np.ndarray, slack: np.ndarray) -> None:
+    """Refuse when the split of the compression impulse among redundant contacts decides v+.
+
+    ``slack`` is the gap rate after compression: the contacts with none share the impulse, in
+    any split ``Pc + d`` with ``G d = 0`` on them. The split moves the bodies after expansion by
+    ``G (e d)``; where that is not zero for some such ``d``, the answer depends on the split.
+    """
+    closed = np.flatnonzero(slack <= SINGULAR * max(float(np.abs(slack).max()), 1.0))
+    if closed.size < 2:
+        return
+    block = G[np.ix_(closed, closed)]
+    splits = scipy.linalg.null_space(block, rcond=SINGULAR)
+    if (
+        splits.size
+        and np.abs(block @ (e[closed, None] * splits)).max() > SINGULAR * np.abs(block).max()
+    ):
+        raise NotApplicable(
+            f"poisson: contacts {closed.tolist()} are redundant (their normals are dependent in "
+            "the kinetic metric) and their coefficients differ: the split of the compression "
+            "impulse among them, which Poisson's law leaves open, decides the outcome"
+        )
 
 
 LAWS.register(Poisson())
