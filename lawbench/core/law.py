@@ -40,6 +40,10 @@ if TYPE_CHECKING:
     from lawbench.core.batch import OutcomeBatch, ProblemBatch
 
 
+# Friction coefficients below this are treated as zero, and the answer says so: their impulses
+# (at most mu times the normal ones) move no velocity beyond the checks' rounding, while cones
+# that thin leave the frictional solvers ill-conditioned.
+NEGLIGIBLE_MU = 1e-9
 # The largest dense copy of a sparse problem made for a law that works on dense matrices: the
 # 100000-ball chain's mass matrix alone would take 75 GiB.
 DENSE_BYTES = 2**31
@@ -148,6 +152,7 @@ class Law(ABC):
         reason = self.tags.refusal(problem)
         if reason:
             raise NotApplicable(f"{self.name}: {reason}")
+        problem, negligible = _without_negligible_friction(problem)
         separating = problem.separating
         rule = self.rule_for_separating(values) if separating else ""
         if separating and not rule:
@@ -176,6 +181,10 @@ class Law(ABC):
             self.name, v_plus=outcome.v_plus, Pn=outcome.Pn, Pt=outcome.Pt, T_plus=outcome.T_plus
         )
         outcome.diagnostics["options"] = values
+        if negligible:
+            outcome.diagnostics["negligible_friction"] = (
+                f"mu below {NEGLIGIBLE_MU:g} at contacts {negligible} treated as 0"
+            )
         if separating:
             outcome.diagnostics["separating_contacts"] = list(separating)
             outcome.diagnostics["separating_rule"] = rule
@@ -299,6 +308,20 @@ class Law(ABC):
         A law with a vectorized path overrides this; it must give the answer of `_resolve`.
         """
         return None
+
+
+def _without_negligible_friction(problem: ImpactProblem) -> tuple[ImpactProblem, list[int]]:
+    """``problem`` with every mu below `NEGLIGIBLE_MU` set to 0, and the contacts changed."""
+    if problem.Wt is None:
+        return problem, []
+    negligible = [j for j, c in enumerate(problem.contacts) if 0 < c.mu < NEGLIGIBLE_MU]
+    if not negligible:
+        return problem, []
+    contacts = [
+        dataclasses.replace(c, mu=0.0) if j in negligible else c
+        for j, c in enumerate(problem.contacts)
+    ]
+    return dataclasses.replace(problem, contacts=contacts), negligible
 
 
 class _Watch:
