@@ -119,7 +119,7 @@ def evaluate(
     elif isinstance(case, str | Case):
         scene = CASES.get(case)
         full = scene.parameters(**params)
-        problem = scene.build(**full)
+        problem = scene.build_from(full)
     else:
         raise TypeError(
             "case must be a scene name (str), a Case or an ImpactProblem, not "
