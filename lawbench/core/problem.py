@@ -378,9 +378,10 @@ class ImpactProblem:
 
     def _check_normals(self) -> None:
         """Refuse a contact that no motion can push along its normal (`KineticMetric`)."""
-        if self.n <= SMALL and not self.sparse:
-            # The Delassus matrix is cheap here and every law needs it: its diagonal serves
-            # (where M^-1 overflows, infinite entries, refused there).
+        if self.n <= SMALL or self.sparse:
+            # The Delassus matrix costs little more than its diagonal here (a small or a sparse
+            # one), and every rigid law needs it: its diagonal serves (where M^-1 overflows,
+            # infinite entries, refused there).
             with np.errstate(over="ignore"):
                 normal = self.delassus.diagonal()
         else:
@@ -583,10 +584,11 @@ def _bodies(bodies: Mapping[str, Sequence[int]] | None, n: int) -> dict[str, tup
     checked: dict[str, tuple[int, ...]] = {}
     for name, indices in (bodies or {}).items():
         try:
-            idx = tuple(int(i) for i in indices)
+            checked[str(name)] = tuple(map(int, indices))
         except (TypeError, ValueError):
             raise InvalidProblem(f"bodies[{str(name)!r}] = {indices!r}: not indices") from None
-        if any(i < 0 or i >= n for i in idx):
-            raise InvalidProblem(f"bodies[{str(name)!r}] = {idx}: indices must lie in [0, {n})")
-        checked[str(name)] = idx
+    every = [i for idx in checked.values() for i in idx]
+    if every and (min(every) < 0 or max(every) >= n):
+        name, idx = next((k, i) for k, i in checked.items() if i and (min(i) < 0 or max(i) >= n))
+        raise InvalidProblem(f"bodies[{name!r}] = {idx}: indices must lie in [0, {n})")
     return checked
