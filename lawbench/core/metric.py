@@ -260,9 +260,12 @@ class KineticMetric:
             Naming the first such contact.
         """
         sparse = is_sparse(W)
-        columns = np.asarray((W.multiply(W) if sparse else W * W).sum(axis=0)).ravel()
-        if normal.min() > 1e-12 * self.largest_inverse * columns.sum():
+        squares = W.multiply(W) if sparse else W * W
+        # The squared Frobenius norm of W bounds its largest squared column: one sum settles
+        # the usual case.
+        if normal.min() > 1e-12 * self.largest_inverse * squares.sum():
             return
+        columns = np.asarray(squares.sum(axis=0)).ravel()
         # Each contact against the inverse masses of the coordinates its normal moves: a light
         # body elsewhere (masses 1e-20 and 1 kg) makes no contact singular.
         geometry = 1e-12 * float(columns.max())

@@ -50,7 +50,8 @@ def solving_units(
         When the impulse or energy unit these give, ``mass velocity`` or ``mass velocity^2``,
         is not a positive double: an answer could not be scaled back.
     """
-    mass = float(np.abs(M.diagonal()).max())
+    # A positive definite M's diagonal entries are positive.
+    mass = float(M.diagonal().max())
     speed = float(np.abs(v).max())
     mass_unit, velocity_unit = (
         1.0 if 1.0 / UNIT_BAND <= size <= UNIT_BAND else binary_scale(size)
