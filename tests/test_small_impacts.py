@@ -14,6 +14,7 @@ import pytest
 
 import lawbench
 from lawbench import Contact, ImpactProblem, InvalidProblem
+from lawbench.core.metric import KineticMetric
 from lawbench.numerics.solvers import _enumerate_sets, clarabel_qp, enumerate_lcp, polish, solve_lcp
 
 
@@ -96,8 +97,8 @@ def test_a_prebuilt_problem_is_resolved_many_times_without_validation(monkeypatc
     def validated_again(*args, **kwargs):
         raise AssertionError("validated again")
 
-    for name in ("_factor_mass", "_check_normals"):
-        monkeypatch.setattr(ImpactProblem, name, validated_again)
+    monkeypatch.setattr(KineticMetric, "__init__", validated_again)
+    monkeypatch.setattr(ImpactProblem, "_check_normals", validated_again)
     monkeypatch.setattr(Contact, "validate", validated_again)
     for _ in range(3):
         for name, outcome in first.items():

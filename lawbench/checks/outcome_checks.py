@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from lawbench.checks.base import TOLERANCE, check
+from lawbench.core.arrays import is_sparse
 from lawbench.core.mechanics import gap_rates
-from lawbench.core.problem import RESTITUTION_FIELDS, is_sparse
+from lawbench.core.problem import RESTITUTION_FIELDS
 from lawbench.core.trial import Trial
 
 # References are closed forms; the laws they describe are exact up to solver polishing.

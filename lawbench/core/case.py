@@ -140,24 +140,49 @@ class Case(ABC):
     def build(self, **given: Any) -> ImpactProblem:
         """Build the impact problem of this scene at the given parameters.
 
+        ``build_from(parameters(**given))``: each parameter is checked and converted once.
+
         Raises
         ------
         InvalidProblem
             For a bad parameter, or parameters whose geometry overflows floating point (the
-            message names the parameters given).
+            message names the parameters that differ from the defaults).
         """
-        params = self.parameters(**given)
-        defaults = self.parameters()
-        changed = {k: v for k, v in given.items() if not np.array_equal(v, defaults.get(k))}
-        named = ", ".join(f"{k} = {v!r}" for k, v in changed.items()) or "the defaults"
+        return self.build_from(self.parameters(**given))
+
+    def build_from(self, params: Mapping[str, Any]) -> ImpactProblem:
+        """Build the impact problem of this scene from complete, checked parameters.
+
+        Parameters
+        ----------
+        params : mapping
+            Every parameter, as `parameters` returns them.
+
+        Raises
+        ------
+        InvalidProblem
+            For parameters whose geometry overflows floating point, or that give a problem no
+            law can take; the message names the parameters that differ from the defaults.
+        """
         try:
-            return self._build(params)
+            return self._build(dict(params))
         except (OverflowError, FloatingPointError) as exc:
-            raise InvalidProblem(f"{self.name}: {named}: the geometry overflows ({exc})") from None
+            reason = f"the geometry overflows ({exc})"
         except InvalidProblem as exc:
             # The scene's formulas at these parameters left double precision, or gave a
-            # problem no law can take: the message names what the user gave.
-            raise InvalidProblem(f"{self.name}: {named}: {exc}") from None
+            # problem no law can take.
+            reason = str(exc)
+        raise InvalidProblem(f"{self.name}: {self._changed(params)}: {reason}") from None
+
+    def _changed(self, params: Params) -> str:
+        """The parameters that differ from their defaults, as ``name = value`` (for messages)."""
+        defaults = self.parameters()
+        changed = [
+            f"{name} = {value!r}"
+            for name, value in params.items()
+            if not np.array_equal(value, defaults.get(name))
+        ]
+        return ", ".join(changed) or "the defaults"
 
     def _check(self, params: dict[str, Any]) -> None:
         """Check relations between parameters (list lengths); raise `InvalidProblem`."""

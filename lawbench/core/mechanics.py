@@ -6,13 +6,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lawbench.core.problem import (
-    SPARSE_SHARE,
-    ImpactProblem,
-    as_array,
-    has_off_diagonal,
-    kinetic_energy,
-)
+from lawbench.core.arrays import as_array
+from lawbench.core.metric import SPARSE_SHARE, has_off_diagonal, kinetic_energy
+from lawbench.core.problem import ImpactProblem
 
 if TYPE_CHECKING:
     import scipy.sparse

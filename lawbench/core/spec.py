@@ -9,19 +9,29 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import KW_ONLY, dataclass
 from typing import Any
+
+import numpy as np
 
 from lawbench.core.errors import InvalidProblem
 
 KINDS = ("float", "int", "bool", "str", "floats")
 _TRUE = {"true", "yes", "1", "on"}
 _FALSE = {"false", "no", "0", "off"}
+# The items of a list numpy converts to floats as Python's float() does; a list holding any
+# other type (a bool, None, a nested list, a complex number) is read item by item.
+_PLAIN_ITEMS = frozenset({float, int, str, np.float64})
 
 
 @dataclass(frozen=True)
 class Spec:
     """A named value of a case or a law.
+
+    ``name``, ``default``, ``doc``, ``unit``, ``kind``, ``low``, ``high`` and ``low_open`` may
+    be given in this order; ``choices`` and ``high_open`` only by keyword. A long positional
+    construction reads better with its bounds named: ``Spec("tol", 1e-10, "tolerance",
+    kind="float", low=0.0, high=0.1, low_open=True)``.
 
     Parameters
     ----------
@@ -51,6 +61,7 @@ class Spec:
     low: float | None = None
     high: float | None = None
     low_open: bool = False
+    _: KW_ONLY
     choices: tuple[str, ...] | None = None
     high_open: bool = False
 
@@ -84,7 +95,7 @@ class Spec:
                 items = [items]
             if len(items) == 0:
                 raise InvalidProblem(f"{self.name} is empty: give at least one number")
-            return [self._number(f"{self.name}[{i}]", x, float) for i, x in enumerate(items)]
+            return self._numbers(items)
         if self.kind == "float":
             return self._number(self.name, value, float)
         if self.kind == "int":
@@ -105,6 +116,31 @@ class Spec:
         if text in _TRUE | _FALSE:
             return text in _TRUE
         raise InvalidProblem(f"{self.name} = {value!r}: must be true or false")
+
+    def _numbers(self, items: Sequence[Any]) -> list[float]:
+        """The items of a 'floats' list, checked and converted in one pass over an array.
+
+        A list that does not convert, or holds a number out of range, is read item by item,
+        which raises naming the first bad one (``masses[3] = 'x': not a number``).
+        """
+        numbers = None
+        if set(map(type, items)) <= _PLAIN_ITEMS:
+            try:
+                numbers = np.array(items, dtype=float)
+            except (TypeError, ValueError, OverflowError):
+                numbers = None
+        if numbers is None or not self._all_allowed(numbers):
+            return [self._number(f"{self.name}[{i}]", x, float) for i, x in enumerate(items)]
+        return numbers.tolist()
+
+    def _all_allowed(self, numbers: np.ndarray) -> bool:
+        """Whether every entry of a float array is finite and within the bounds."""
+        allowed = np.isfinite(numbers)
+        if self.low is not None:
+            allowed &= (numbers > self.low) if self.low_open else (numbers >= self.low)
+        if self.high is not None:
+            allowed &= (numbers < self.high) if self.high_open else (numbers <= self.high)
+        return bool(allowed.all())
 
     def _number(self, label: str, value: Any, kind: type) -> float | int:
         try:

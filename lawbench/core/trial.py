@@ -176,7 +176,7 @@ def make_trial(
     if isinstance(source, str | Case):
         scene = CASES.get(source)
         full = scene.parameters(**(params or {}))
-        problem = scene.build(**full)
+        problem = scene.build_from(full)
     elif params:
         raise InvalidProblem(
             f"scene parameters {sorted(params)} given with a problem: a problem is solved as it is"

@@ -40,11 +40,12 @@ import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
+from lawbench.core.arrays import as_array
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, LawbenchError, LossyExport, NotApplicable
 from lawbench.core.mechanics import fc3d_error
 from lawbench.core.outcome import Outcome
-from lawbench.core.problem import ImpactProblem, as_array
+from lawbench.core.problem import ImpactProblem
 from lawbench.files.hdf5 import require_h5py
 from lawbench.files.paths import input_file, output_file
 

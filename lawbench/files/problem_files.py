@@ -39,10 +39,11 @@ from typing import Any
 import numpy as np
 import scipy.sparse
 
+from lawbench.core.arrays import is_sparse
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.outcome import Outcome
-from lawbench.core.problem import Contact, ImpactProblem, is_sparse
+from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.files.hdf5 import require_h5py
 from lawbench.files.paths import MAX_BYTES, input_file, output_file
 

@@ -44,10 +44,13 @@ def chain_problem(
         Initial gaps (m); zero by default.
     """
     M, Wn = _mass_and_normals(np.asarray(masses, dtype=float), pairs)
-    contacts = [
-        Contact(e=e, stiffness=k, exponent=exponent)
-        for e, k, exponent in zip(restitution, stiffness, exponents, strict=True)
-    ]
+    springs = list(zip(restitution, stiffness, exponents, strict=True))
+    # Contacts of equal coefficients share one (immutable) contact, built and checked once.
+    shared = {
+        spring: Contact(e=spring[0], stiffness=spring[1], exponent=spring[2])
+        for spring in set(springs)
+    }
+    contacts = [shared[spring] for spring in springs]
     return ImpactProblem(
         M=M,
         Wn=Wn,
@@ -60,13 +63,12 @@ def chain_problem(
 
 def _mass_and_normals(masses: np.ndarray, pairs: Sequence[Pair]) -> tuple[Any, Any]:
     """Diagonal mass matrix and normal Jacobian: arrays, or CSC beyond `SPARSE_CONTACTS`."""
-    entries = [
-        (ball, j, sign)
-        for j, pair in enumerate(pairs)
-        for ball, sign in zip(pair, (-1.0, 1.0), strict=True)
-        if ball is not None
-    ]
-    rows, columns, signs = (np.array(values) for values in zip(*entries, strict=True))
+    # Ball indices of each contact's left and right side; a wall (None) reads as NaN.
+    ends = np.array(pairs, dtype=float).reshape(len(pairs), 2)
+    ball = ~np.isnan(ends)
+    rows = ends[ball].astype(int)
+    columns = np.nonzero(ball)[0]
+    signs = np.broadcast_to([-1.0, 1.0], ends.shape)[ball]
     shape = (len(masses), len(pairs))
     if len(pairs) <= SPARSE_CONTACTS:
         Wn = np.zeros(shape)

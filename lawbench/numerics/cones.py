@@ -32,7 +32,7 @@ import scipy.sparse
 from lawbench.core import budget
 from lawbench.core.errors import SolverFailure
 from lawbench.core.mechanics import project
-from lawbench.core.problem import binary_scale
+from lawbench.core.units import binary_scale
 from lawbench.numerics.solvers import clarabel_settings
 
 NEWTON_STEPS = 30

@@ -68,10 +68,11 @@ from __future__ import annotations
 
 from typing import Any
 
+from lawbench.core.arrays import all_finite
 from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
-from lawbench.core.problem import ImpactProblem, all_finite
+from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.laws._claims import keeps_energy, never_creates_energy

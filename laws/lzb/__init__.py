@@ -42,18 +42,18 @@ sticking contact whose force reaches its cone slips against that force. When sti
 have redundant tangential directions their forces are split with the minimum norm. A spatial
 frictional problem is refused.
 
-Start from zero stored energy. Stepping in ``P_i`` is singular where ``E_i = 0``: the rule is
-0/0 at the start and ``dtau/dP_i = 1/F_i`` is unbounded at the start and the end of each
-loading, and a fixed impulse step there converges to wrong answers however small the step.
-The state is written instead in the regular variables ``d_j = ((eta_j+1) E_j / K_j)^(1/(eta_j+1))``, with
-``dd_j = -un_j dtau / xi_j`` (``xi = 1``, or ``e*^2`` in a bi-stiffness expansion) and
-``dP_j = K_j d_j^eta_j dtau``, where ``dtau = dP_i / F_i`` is common to all contacts (the rule
-says exactly that the impulses grow as the forces) and is the time of the springs. A contact
-that approaches starts at ``d_j = 0`` with ``dd_j/dtau = -un_j > 0``: no first impulse has to
-be guessed. The integrator steps in the primary impulse ``P_i`` while the primary stores at
-least 1% of the reference energy ``max_j (un-_j)^2 / (2 G_jj)``, and in ``tau`` below that (at
-the start and the end of the loadings). The primary changes, as an event, when another contact
-stores more energy (ties within 1e-6 relative keep the current one).
+Start from zero stored energy. Stepping in ``P_i`` is singular where ``E_i = 0``: the rule is 0/0 at
+the start and ``dtau/dP_i = 1/F_i`` is unbounded at the start and the end of each loading, and a
+fixed impulse step there converges to wrong answers however small the step. The state is written
+instead in the regular variables ``d_j = ((eta_j+1) E_j / K_j)^(1/(eta_j+1))``, with ``dd_j = -un_j
+dtau / xi_j`` (``xi = 1``, or ``e*^2`` in a bi-stiffness expansion) and ``dP_j = K_j d_j^eta_j
+dtau``, where ``dtau = dP_i / F_i`` is common to all contacts (the rule says exactly that the
+impulses grow as the forces) and is the time of the springs. A contact that approaches starts at
+``d_j = 0`` with ``dd_j/dtau = -un_j > 0``: no first impulse has to be guessed. The integrator steps
+in the primary impulse ``P_i`` while the primary stores at least 1% of the reference energy ``max_j
+(un-_j)^2 / (2 G_jj)``, and in ``tau`` below that (at the start and the end of the loadings). The
+primary changes, as an event, when another contact stores more energy (ties within 1e-6 relative
+keep the current one).
 
 Energy and accuracy. The equations keep ``T + sum_j E_j`` exactly (e* = 1, no friction); they
 are integrated by scipy's DOP853 (option ``method``) at relative tolerance ``tol``, the

@@ -1,0 +1,278 @@
+"""The kinetic metric of an impact: the mass matrix M, its factor, and the Delassus matrices.
+
+An impulse ``P`` along the columns of a Jacobian ``W`` changes the velocity by ``M^-1 W P`` and
+the contact velocities ``W.T v`` by ``W.T M^-1 W P``: the Delassus matrix of ``W``, the contact
+compliance every rigid law works with. `KineticMetric` checks that M is symmetric positive
+definite, keeps the cheapest exact way to apply ``M^-1`` (the reciprocal diagonal of a diagonal
+M, the inverse of a small one, a Cholesky or sparse LU factor beyond), and forms these matrices,
+dense or sparse.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NoReturn
+
+import numpy as np
+
+from lawbench.core.arrays import all_finite, is_sparse
+from lawbench.core.errors import InvalidProblem
+
+# Up to this many coordinates the inverse of M is kept: a product is cheaper than a solve.
+SMALL = 64
+# A matrix with at most this share of non-zero entries is multiplied as a sparse one.
+SPARSE_SHARE = 0.05
+# Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
+SOLVE_BLOCK = 256
+
+
+@np.errstate(over="ignore", invalid="ignore")
+def kinetic_energy(M: Any, v: np.ndarray) -> float:
+    """Return ``v @ M @ v / 2`` (inf, without a warning, when it overflows)."""
+    return float(v.dot(M.dot(v))) / 2.0
+
+
+def has_off_diagonal(M: Any) -> bool:
+    """Whether M (dense or sparse) has a non-zero entry off its diagonal."""
+    if isinstance(M, np.ndarray):
+        return np.count_nonzero(M) != np.count_nonzero(M.diagonal())
+    coo = M.tocoo()
+    return bool(np.any(coo.data[coo.row != coo.col]))
+
+
+def _cho_solve(factor: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """``M^-1 rhs`` from M's lower Cholesky factor.
+
+    numpy's solves for a small M (no scipy.linalg to import), scipy's triangular ones beyond.
+    """
+    if factor.shape[0] <= SMALL:
+        return np.linalg.solve(factor.T, np.linalg.solve(factor, rhs))
+    import scipy.linalg
+
+    return scipy.linalg.cho_solve((factor, True), rhs, check_finite=False)
+
+
+def _sparse_factor(M: Any) -> Any:
+    """Sparse LU factor of a symmetric M with symmetric ordering and no pivoting, or None.
+
+    Without pivoting the factor is ``P M P.T = L D L.T`` written as ``L U``: M is positive
+    definite exactly when every pivot, the diagonal of U, is positive.
+    """
+    import scipy.sparse.linalg
+
+    try:
+        factor = scipy.sparse.linalg.splu(
+            M,
+            permc_spec="MMD_AT_PLUS_A",
+            diag_pivot_thresh=0.0,
+            options={"SymmetricMode": True},
+        )
+    except RuntimeError:  # an exactly singular pivot
+        return None
+    if not np.array_equal(factor.perm_r, factor.perm_c) or (factor.U.diagonal() <= 0).any():
+        return None
+    return factor
+
+
+class KineticMetric:
+    """A symmetric positive definite mass matrix M, checked, with what applies ``M^-1``.
+
+    Parameters
+    ----------
+    M : array (n, n) or scipy.sparse CSC array
+        The (read-only, finite) mass matrix in generalized coordinates.
+
+    Attributes
+    ----------
+    M : array or CSC array (n, n)
+        The mass matrix.
+    sparse : bool
+        Whether M is a scipy.sparse array.
+    inverse_diagonal : array (n,) or None
+        ``1 / diag(M)`` for a diagonal M: then ``M^-1`` is exact and costs O(n).
+    inverse : array (n, n) or None
+        ``M^-1`` of a small (at most `SMALL` coordinates) non-diagonal M.
+    largest_inverse : float
+        The largest diagonal entry of ``M^-1`` (a lower bound of it for a sparse,
+        non-diagonal M): the scale of the inverse mass, within a factor n of its norm.
+
+    Raises
+    ------
+    InvalidProblem
+        When M is not symmetric positive definite, or so close to singular that its inverse
+        overflows.
+    """
+
+    def __init__(self, M: Any) -> None:
+        self.M = M
+        self.n = M.shape[0]
+        self.sparse = is_sparse(M)
+        self.inverse_diagonal: np.ndarray | None = None
+        self.inverse: np.ndarray | None = None
+        self._cholesky: np.ndarray | None = None
+        self._factor: Any = None
+        diagonal = M.diagonal()
+        # A positive definite M has no zero on its diagonal: with n non-zero entries it is
+        # diagonal, and with fewer, or a zero on the diagonal, the test below refuses it.
+        stored = M.count_nonzero() if self.sparse else np.count_nonzero(M)
+        if stored <= self.n:
+            self.largest_inverse = self._invert_diagonal(diagonal)
+            return
+        asymmetry = abs(M - M.T).max()
+        if asymmetry > 1e-12 * abs(M).max():
+            raise InvalidProblem(f"M is not symmetric (largest |M - M.T| = {asymmetry:.3g})")
+        if self.sparse:
+            self._factor = _sparse_factor(M)
+            if self._factor is None:
+                raise InvalidProblem("M is not positive definite")
+            # (M^-1)_ii >= 1 / M_ii (Cauchy-Schwarz): a bound without the inverse, enough for
+            # a test at rounding level.
+            self.largest_inverse = float((1.0 / diagonal).max())
+            return
+        try:
+            self._cholesky = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            raise InvalidProblem("M is not positive definite") from None
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            inverse = _cho_solve(self._cholesky, np.eye(self.n))
+        if not all_finite(inverse):
+            self._too_close_to_singular()
+        if self.n <= SMALL:
+            inverse.setflags(write=False)
+            self.inverse = inverse
+        self.largest_inverse = float(inverse.diagonal().max())
+
+    def _invert_diagonal(self, diagonal: np.ndarray) -> float:
+        """Keep the reciprocal of a diagonal M and return its largest entry."""
+        lightest = float(diagonal.min())
+        if not lightest > 0:
+            raise InvalidProblem("M is not positive definite")
+        if math.isinf(1.0 / lightest):
+            self._too_close_to_singular()
+        reciprocal = 1.0 / diagonal
+        reciprocal.setflags(write=False)
+        self.inverse_diagonal = reciprocal
+        # Rounded division is monotone: the largest reciprocal is that of the smallest mass.
+        return 1.0 / lightest
+
+    def _too_close_to_singular(self) -> NoReturn:
+        diagonal = self.M.diagonal()
+        lightest = int(np.argmin(diagonal))
+        raise InvalidProblem(
+            f"M is too close to singular: its inverse overflows (smallest diagonal entry "
+            f"M[{lightest}, {lightest}] = {diagonal.min():.3g})"
+        )
+
+    def solve(self, rhs: Any) -> Any:
+        """Return ``M^-1 @ rhs``; a sparse ``rhs`` gives a sparse answer."""
+        if is_sparse(rhs):
+            return self.solve_sparse(rhs)
+        reciprocal = self.inverse_diagonal
+        if reciprocal is not None:
+            return reciprocal * rhs if np.ndim(rhs) == 1 else reciprocal[:, None] * rhs
+        if self.inverse is not None:
+            return self.inverse.dot(rhs)
+        if self._factor is not None:
+            return self._factor.solve(np.asarray(rhs, dtype=float))
+        return _cho_solve(self._cholesky, rhs)
+
+    def solve_sparse(self, W: Any) -> Any:
+        """``M^-1 W`` of a sparse ``W`` as a CSC array, in O(nnz) for a diagonal M.
+
+        Through M's sparse factor ``SOLVE_BLOCK`` columns at a time, keeping non-zero entries.
+        """
+        import scipy.sparse
+
+        reciprocal = self.inverse_diagonal
+        if reciprocal is not None:
+            return scipy.sparse.csc_array(W.multiply(reciprocal[:, None]))
+        if not self.sparse:
+            return scipy.sparse.csc_array(self.solve(W.toarray()))
+        blocks = [
+            scipy.sparse.csc_array(self.solve(W[:, k : k + SOLVE_BLOCK].toarray()))
+            for k in range(0, W.shape[1], SOLVE_BLOCK)
+        ]
+        return scipy.sparse.hstack(blocks, format="csc")
+
+    def sparse_delassus(self, W: Any) -> Any:
+        """``W.T M^-1 W`` of a sparse ``W``, symmetrized, as a CSC array."""
+        G = W.T @ self.solve_sparse(W)
+        return ((G + G.T) / 2).tocsc()
+
+    def delassus(self, W: Any) -> Any:
+        """The Delassus matrix ``W.T M^-1 W`` of a Jacobian ``W``, read-only when dense.
+
+        Sparse for a sparse ``W``. A dense ``W`` with few non-zero entries beyond `SMALL`
+        coordinates (chains and columns: each contact moves two bodies, so the matrix is
+        banded) is multiplied as a sparse one, in O(nnz) instead of O(n m^2).
+        """
+        if is_sparse(W):
+            return self.sparse_delassus(W)
+        if self.n > SMALL and np.count_nonzero(W) <= SPARSE_SHARE * W.size:
+            import scipy.sparse
+
+            G = self.sparse_delassus(scipy.sparse.csc_array(W)).toarray()
+        elif self.inverse_diagonal is not None:
+            # S.T S with S = M^-1/2 W: symmetric as computed (one product, no symmetrizing).
+            scaled = W * np.sqrt(self.inverse_diagonal)[:, None]
+            G = scaled.T.dot(scaled)
+        else:
+            return self.symmetric_product(W)
+        G.setflags(write=False)
+        return G
+
+    def symmetric_product(self, W: np.ndarray) -> np.ndarray:
+        """``W.T M^-1 W`` of a dense ``W`` by one solve, symmetrized, read-only."""
+        G = W.T.dot(self.solve(W))
+        G = (G + G.T) / 2
+        G.setflags(write=False)
+        return G
+
+    def compliances(self, W: Any) -> np.ndarray:
+        """The diagonal of ``W.T M^-1 W`` without the whole matrix."""
+        if is_sparse(W):
+            return np.asarray(W.multiply(self.solve_sparse(W)).sum(axis=0)).ravel()
+        return np.einsum("ij,ij->j", W, self.solve(W))
+
+    def inverse_mass_on(self, column: np.ndarray) -> float:
+        """The largest diagonal entry of ``M^-1`` over the coordinates a column moves.
+
+        `largest_inverse` where M^-1's diagonal is not at hand.
+        """
+        diagonal = self.inverse_diagonal
+        if diagonal is None and self.inverse is not None:
+            diagonal = self.inverse.diagonal()
+        if diagonal is None or not column.any():
+            return self.largest_inverse
+        return float(diagonal[column != 0].max())
+
+    def refuse_singular_normals(self, Wn: Any, W: Any, normal: np.ndarray) -> None:
+        """Refuse a contact that no motion can push along its normal (a singular configuration).
+
+        Its normal Delassus entry ``normal[j]`` is then rounding noise (for example a pendulum
+        hanging straight down onto the floor), and every law's impulse would be meaningless.
+        The largest diagonal entry of M^-1, within a factor n of its largest eigenvalue, and
+        the columns of the whole Jacobian ``W`` give the scale of a test at rounding level.
+
+        Raises
+        ------
+        InvalidProblem
+            Naming the first such contact.
+        """
+        sparse = is_sparse(W)
+        squares = W.multiply(W) if sparse else W * W
+        # The squared Frobenius norm of W bounds its largest squared column: one sum settles
+        # the usual case.
+        if normal.min() > 1e-12 * self.largest_inverse * squares.sum():
+            return
+        columns = np.asarray(squares.sum(axis=0)).ravel()
+        # Each contact against the inverse masses of the coordinates its normal moves: a light
+        # body elsewhere (masses 1e-20 and 1 kg) makes no contact singular.
+        geometry = 1e-12 * float(columns.max())
+        for j in range(Wn.shape[1]):
+            column = Wn[:, [j]].toarray().ravel() if sparse else Wn[:, j]
+            if not normal[j] / self.inverse_mass_on(column) > geometry:
+                raise InvalidProblem(
+                    f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 "
+                    f"Wn[:, {j}] = {normal[j]:.3g}): a singular configuration"
+                )
