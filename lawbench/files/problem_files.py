@@ -202,9 +202,16 @@ def read_problem(path: str | Path) -> ProblemFile:
 def file_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
     """What the problem file ``path``'s own data say of ``outcome`` (`FileFacts.diagnostics`).
 
-    A caller that has read the file already takes them from its `read_problem` facts instead.
+    Only an FCLIB file has something to say, and it is read again for it: a caller that has
+    read the file already takes them from its `read_problem` facts instead. Lawbench's own
+    formats hold the problem exactly as it is solved, and are not opened.
     """
-    return read_problem(path).facts.diagnostics(outcome)
+    path = Path(path)
+    if _codec(path)[1] is not _read_hdf5:
+        return {}
+    from lawbench.files.fclib import fclib_diagnostics, fclib_form
+
+    return fclib_diagnostics(path, outcome) if fclib_form(path) else {}
 
 
 @dataclass(frozen=True)
