@@ -252,32 +252,19 @@ LAWS = lawbench.LAWS.names()
 CASES = lawbench.CASES.names()
 CHAIN_PARAMETERS = [spec.name for spec in lawbench.CASES.get("three_ball_chain").params]
 SEQUENTIAL_OPTIONS = [spec.name for spec in lawbench.LAWS.get("sequential").options]
+
+
+def chain_setting(setting: str, patterns: list[str], id: str) -> object:
+    """A bad ``--set`` of ``solve newton three_ball_chain``, and what its message names."""
+    return pytest.param(["solve", "newton", "three_ball_chain", "--set", setting], patterns, id=id)
+
+
 BAD_INPUT = [
-    pytest.param(
-        ["solve", "newton", "three_ball_chain", "--set", "e=1.5"],
-        [r"(?<![\w'\[])e(\[\d+\])?(?!\w)", r"1\.5"],
-        id="restitution-above-one",
-    ),
-    pytest.param(
-        ["solve", "newton", "three_ball_chain", "--set", "masses=1,-1,1"],
-        [r"masses\[1\]", "-1"],
-        id="negative-mass",
-    ),
-    pytest.param(
-        ["solve", "newton", "three_ball_chain", "--set", "velocities=1,0"],
-        [r"\bvelocities\b"],
-        id="wrong-number-of-velocities",
-    ),
-    pytest.param(
-        ["solve", "newton", "three_ball_chain", "--set", "velocities=nan,0,0"],
-        [r"velocities\[0\]", "(?i)nan"],
-        id="nan-velocity",
-    ),
-    pytest.param(
-        ["solve", "newton", "three_ball_chain", "--set", "foo=1"],
-        ["foo", *listing(CHAIN_PARAMETERS)],
-        id="unknown-parameter",
-    ),
+    chain_setting("e=1.5", [r"(?<![\w'\[])e(\[\d+\])?(?!\w)", r"1\.5"], "restitution-above-one"),
+    chain_setting("masses=1,-1,1", [r"masses\[1\]", "-1"], "negative-mass"),
+    chain_setting("velocities=1,0", [r"\bvelocities\b"], "wrong-number-of-velocities"),
+    chain_setting("velocities=nan,0,0", [r"velocities\[0\]", "(?i)nan"], "nan-velocity"),
+    chain_setting("foo=1", ["foo", *listing(CHAIN_PARAMETERS)], "unknown-parameter"),
     pytest.param(
         ["solve", "foo", "three_ball_chain"],
         ["foo", *listing(LAWS)],

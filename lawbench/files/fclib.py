@@ -19,8 +19,10 @@ no impact, its ``M`` not symmetric (LMGC90 writes such iteration matrices) or wi
 ``q = H.T M^-1 f + w``, the reason in the problem's name. The local form has no generalized
 coordinates: it is read as the `ContactProblem` it is, ``W`` and ``q`` as given (an asymmetric
 ``W`` is kept, and its asymmetry reported by the solve; ``q`` need not lie in the range of
-``W``). `fclib_diagnostics` gives the FC3D error of a global problem's answer on the file's own
-data, the measure of the field's comparisons; a contact-space solve reports it itself.
+``W``). The file is read once (`read_fclib_file`): its problem comes with the facts of the
+reading (`lawbench.files.facts.FileFacts`), among them the file's own ``W`` and ``q``, on which
+an answer of a global problem has its FC3D error, the measure of the field's comparisons; a
+contact-space solve reports it itself.
 
 Matrices are read in any of FCLIB's sparse layouts (``nz = -1`` compressed columns, ``-2``
 compressed rows, ``>= 0`` triplets: row ``i[k]``, column ``p[k]``), their index arrays checked
@@ -30,9 +32,9 @@ needs h5py.
 
 from __future__ import annotations
 
+import functools
 import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -43,9 +45,9 @@ import scipy.sparse.linalg
 from lawbench.core.arrays import as_array
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, LawbenchError, LossyExport, NotApplicable
-from lawbench.core.mechanics import fc3d_error
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
+from lawbench.files.facts import LAYOUTS, ContactSpace, FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py
 from lawbench.files.paths import input_file, output_file
 
@@ -62,25 +64,27 @@ SUFFIXES = (".h5", ".hdf5")
 OTHER_FORMS = {"fclib_global_rolling": "the global problem with rolling friction"}
 
 
-def is_fclib(path: str | Path) -> bool:
-    """Whether ``path`` is an HDF5 file holding an FCLIB problem (of any form)."""
-    return fclib_form(path) is not None
-
-
 def fclib_form(path: str | Path) -> str | None:
     """The FCLIB form ``path`` holds ('local', 'global' or another of FCLIB's), or None."""
     try:
         with require_h5py().File(path, "r") as handle:
-            for group in [f"fclib_{form}" for form in FORMS] + list(OTHER_FORMS):
-                if group in handle:
-                    return group.removeprefix("fclib_")
+            return form_of(handle)
     except (OSError, RuntimeError, KeyError):  # not HDF5, or a damaged one
         return None
+
+
+def form_of(handle: Any) -> str | None:
+    """The FCLIB form an open HDF5 file holds ('local', 'global' or another), or None."""
+    for group in [f"fclib_{form}" for form in FORMS] + list(OTHER_FORMS):
+        if group in handle:
+            return group.removeprefix("fclib_")
     return None
 
 
-def _read_matrix(group: Any, where: str) -> scipy.sparse.csr_matrix:
-    """A sparse matrix in any of FCLIB's layouts, index arrays checked against its shape first.
+def _read_matrix(group: Any, where: str) -> tuple[scipy.sparse.csr_matrix, str]:
+    """A sparse matrix in any of FCLIB's layouts, and that layout (one of `LAYOUTS`).
+
+    Index arrays are checked against the matrix's shape before scipy sees them.
 
     Triplets (``nz >= 0``) hold the row of entry k in ``i[k]`` and its column in ``p[k]``:
     CSparse's triplets, which Siconos and LMGC90 write (the field comments of ``fclib.h`` name
@@ -111,7 +115,7 @@ def _read_matrix(group: Any, where: str) -> scipy.sparse.csr_matrix:
         rows, columns = i[:nz], p[:nz]
         _within(rows, m, f"{where}/i (rows)")
         _within(columns, n, f"{where}/p (columns)")
-        return scipy.sparse.coo_matrix((x[:nz], (rows, columns)), shape=(m, n)).tocsr()
+        return scipy.sparse.coo_matrix((x[:nz], (rows, columns)), shape=(m, n)).tocsr(), LAYOUTS[0]
     if nz not in (-1, -2):
         raise InvalidProblem(f"{where}/nz = {nz}: not an FCLIB sparse layout (-2, -1 or >= 0)")
     major, minor, layout = (n, m, "columns") if nz == -1 else (m, n, "rows")
@@ -128,7 +132,7 @@ def _read_matrix(group: Any, where: str) -> scipy.sparse.csr_matrix:
     _within(i[: p[-1]], minor, f"{where}/i")
     arrays = (x[: p[-1]], i[: p[-1]], p)
     matrix = scipy.sparse.csc_matrix if nz == -1 else scipy.sparse.csr_matrix
-    return scipy.sparse.csr_matrix(matrix(arrays, shape=(m, n)))
+    return scipy.sparse.csr_matrix(matrix(arrays, shape=(m, n))), LAYOUTS[-nz]
 
 
 def _array(group: Any, key: str, where: str) -> np.ndarray:
@@ -188,48 +192,19 @@ def _local_order(problem: ImpactProblem) -> np.ndarray:
     )
 
 
-@contextmanager
-def _opened(path: str | Path) -> Iterator[tuple[Any, str, str, int]]:
-    """The open file's problem group, its form, its name for messages and its ``spacedim``."""
-    where = str(input_file(path, "FCLIB file"))
-    try:
-        handle = require_h5py().File(path, "r")
-    except OSError as exc:
-        raise InvalidProblem(f"{where}: cannot be read as HDF5 ({exc})") from None
-    with handle:
-        try:
-            if "fclib_global" in handle:
-                root, form = handle["fclib_global"], "global"
-            elif "fclib_local" in handle:
-                root, form = handle["fclib_local"], "local"
-            else:
-                for group, name in OTHER_FORMS.items():
-                    if group in handle:
-                        raise NotApplicable(
-                            f"{where}: /{group} is FCLIB's {name}; the impact laws here have "
-                            "Coulomb friction only (no rolling resistance)"
-                        )
-                raise InvalidProblem(f"{where}: neither /fclib_local nor /fclib_global")
-            where = f"{where}:/fclib_{form}"
-            dim = int(np.asarray(root["spacedim"][()]).ravel()[0]) if "spacedim" in root else 3
-            if dim not in (2, 3):
-                raise InvalidProblem(f"{where}/spacedim = {dim}: must be 2 or 3")
-            if "vectors" not in root:
-                raise InvalidProblem(f"{where}/vectors is missing")
-            yield root, form, where, dim
-        except LawbenchError:
-            raise
-        except (OSError, RuntimeError, KeyError, ValueError) as exc:
-            # h5py's errors for a damaged structure, met wherever the file is read.
-            raise InvalidProblem(f"{where}: a damaged HDF5 file ({exc})") from None
-
-
 def read_fclib(path: str | Path) -> ImpactProblem | ContactProblem:
+    """The problem of an FCLIB file (`read_fclib_file`), without what its reading learned."""
+    return read_fclib_file(path).problem
+
+
+def read_fclib_file(path: str | Path) -> ProblemFile:
     """Read an FCLIB file: the global form as an impact, the local form as given.
 
     The global form is an `ImpactProblem` with ``e = 0`` (or, when its ``M`` is not symmetric
     or it has an offset ``w``, the `ContactProblem` ``W = H.T M^-1 H``, ``q = H.T M^-1 f + w``);
-    the local form a `ContactProblem` with ``W`` and ``q`` as the file holds them.
+    the local form a `ContactProblem` with ``W`` and ``q`` as the file holds them. The facts
+    name the form, each matrix's layout, the reformulation applied, and give the file's own
+    ``W`` and ``q`` (for the FC3D error of an answer, W's asymmetry and rank).
 
     Raises
     ------
@@ -240,32 +215,114 @@ def read_fclib(path: str | Path) -> ImpactProblem | ContactProblem:
     NotApplicable
         For FCLIB's rolling-friction form: no impact law here has rolling resistance.
     """
-    with _opened(path) as (root, form, where, dim):
+    where = str(input_file(path, "FCLIB file"))
+    try:
+        handle = require_h5py().File(path, "r")
+    except OSError as exc:
+        raise InvalidProblem(f"{where}: cannot be read as HDF5 ({exc})") from None
+    with handle:
+        read = read_open(handle, where)
+    return read.interpret()
+
+
+@dataclass(frozen=True)
+class FclibRead:
+    """The arrays of an FCLIB file's problem, read; `interpret` makes its problem and facts."""
+
+    form: str
+    where: str
+    dim: int
+    mu: np.ndarray
+    arrays: dict[str, Any]
+    storage: tuple[tuple[str, str], ...]
+
+    def interpret(self) -> ProblemFile:
+        """The problem the arrays define, with the facts of the file (`read_fclib_file`)."""
+        where, dim, mu = self.where, self.dim, self.mu
+        if self.form == "local":
+            W, q = self.arrays["W"], self.arrays["q"]
+            space = ContactSpace(W, q, mu, dim)
+            return ProblemFile(
+                ContactProblem(W, q, mu, dim, name=where),
+                FileFacts("local", self.storage, contact_space=lambda: space),
+            )
+        M, H, f, w = (self.arrays[key] for key in ("M", "H", "f", "w"))
+
+        @functools.cache
+        def contact_space() -> ContactSpace:
+            # Siconos' reformulation of the global form: W = H.T M^-1 H, q = H.T M^-1 f + w.
+            W = H.T @ _solve(M, as_array(H), where)
+            return ContactSpace(W, H.T @ _solve(M, f, where) + w, mu, dim)
+
+        reason = _no_impact(M, w)
+        facts = FileFacts("global", self.storage, reason, contact_space)
+        if reason:
+            space = contact_space()
+            name = f"{where} (in contact space: {reason})"
+            return ProblemFile(ContactProblem(space.W, space.q, mu, dim, name=name), facts)
+        try:
+            problem = ImpactProblem.from_arrays(
+                M, v=_solve(M, f, where), **_split(H, dim, mu, where), e=0.0, mu=mu
+            )
+        except InvalidProblem as exc:
+            raise InvalidProblem(f"{where}: {exc}") from None
+        return ProblemFile(problem, facts)
+
+
+def read_open(handle: Any, where: str) -> FclibRead:
+    """Read the FCLIB problem of the open HDF5 file ``handle`` (named ``where`` in messages).
+
+    Raises
+    ------
+    InvalidProblem, NotApplicable
+        As `read_fclib_file`, for what the file holds (its interpretation raises the rest).
+    """
+    try:
+        root, form, where, dim = _root(handle, where)
         vectors = root["vectors"]
         mu = _vector(vectors, "mu", f"{where}/vectors")
         if form == "local":
             if "V" in root or "R" in root:
                 raise InvalidProblem(f"{where}/V, R: mixed problems are not an impact problem")
-            W, q = _local(root, mu.size * dim, where)
-            return ContactProblem(W, q, mu, dim, name=where)
+            W, layout = _read_matrix(root["W"], f"{where}/W")
+            arrays = {"W": W, "q": _vector(vectors, "q", f"{where}/vectors")}
+            _check_local(W, arrays["q"], mu.size * dim, where)
+            return FclibRead(form, where, dim, mu, arrays, (("W", layout),))
         if "G" in root:
             raise InvalidProblem(f"{where}/G: equality constraints are not an impact problem")
-        M = _held(_read_matrix(root["M"], f"{where}/M"))
-        H = _held(_read_matrix(root["H"], f"{where}/H"))
-        f = _vector(vectors, "f", f"{where}/vectors")
-        w = _vector(vectors, "w", f"{where}/vectors")
-    reason = _no_impact(M, w)
-    if reason:
-        # Siconos' reformulation of the global form: W = H.T M^-1 H, q = H.T M^-1 f + w.
-        W = H.T @ _solve(M, as_array(H), where)
-        q = H.T @ _solve(M, f, where) + w
-        return ContactProblem(W, q, mu, dim, name=f"{where} (in contact space: {reason})")
-    try:
-        return ImpactProblem.from_arrays(
-            M, v=_solve(M, f, where), **_split(H, dim, mu, where), e=0.0, mu=mu
-        )
-    except InvalidProblem as exc:
-        raise InvalidProblem(f"{where}: {exc}") from None
+        (M, of_M), (H, of_H) = (_read_matrix(root[k], f"{where}/{k}") for k in ("M", "H"))
+        arrays = {"M": _held(M), "H": _held(H)}
+        arrays |= {key: _vector(vectors, key, f"{where}/vectors") for key in ("f", "w")}
+        return FclibRead(form, where, dim, mu, arrays, (("M", of_M), ("H", of_H)))
+    except LawbenchError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError) as exc:
+        # h5py's errors for a damaged structure, met wherever the file is read.
+        raise InvalidProblem(f"{where}: a damaged HDF5 file ({exc})") from None
+
+
+def _root(handle: Any, where: str) -> tuple[Any, str, str, int]:
+    """The open file's problem group, its form, its name for messages and its ``spacedim``."""
+    if "fclib_global" in handle:
+        form = "global"
+    elif "fclib_local" in handle:
+        form = "local"
+    else:
+        for group, name in OTHER_FORMS.items():
+            if group in handle:
+                raise NotApplicable(
+                    f"{where}: /{group} is FCLIB's {name}; the impact laws here have "
+                    "Coulomb friction only (no rolling resistance)"
+                )
+        raise InvalidProblem(f"{where}: neither /fclib_local nor /fclib_global")
+    root = handle[f"fclib_{form}"]
+    where = f"{where}:/fclib_{form}"
+    dim = int(np.asarray(root["spacedim"][()]).ravel()[0]) if "spacedim" in root else 3
+    if dim not in (2, 3):
+        raise InvalidProblem(f"{where}/spacedim = {dim}: must be 2 or 3")
+    if "vectors" not in root:
+        raise InvalidProblem(f"{where}/vectors is missing")
+    return root, form, where, dim
 
 
 def _no_impact(M: Any, w: np.ndarray) -> str:
@@ -278,16 +335,13 @@ def _no_impact(M: Any, w: np.ndarray) -> str:
     return ""
 
 
-def _local(root: Any, size: int, where: str) -> tuple[Any, np.ndarray]:
-    """The local form's ``W`` (sparse) and ``q``, checked to be ``size`` square and long."""
-    W = _read_matrix(root["W"], f"{where}/W")
-    q = _vector(root["vectors"], "q", f"{where}/vectors")
+def _check_local(W: Any, q: np.ndarray, size: int, where: str) -> None:
+    """Refuse a local form whose ``W`` is not ``size`` square or whose ``q`` is not as long."""
     if W.shape != (size, size) or q.size != size:
         raise InvalidProblem(
             f"{where}: W is {W.shape[0]} x {W.shape[1]} and q holds {q.size} entries; "
             f"{size} contact coordinates (spacedim times the entries of mu) need {size} x {size}"
         )
-    return W, q
 
 
 def _solve(M: Any, rhs: np.ndarray, where: str) -> np.ndarray:
@@ -310,29 +364,8 @@ def _held(matrix: scipy.sparse.csr_matrix) -> Any:
 
 
 def fclib_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
-    """How ``outcome`` answers the global FCLIB problem of ``path``, on the file's own data.
-
-    ``fc3d_error``: Acary, Brémond and Huber's measure (`lawbench.core.mechanics.fc3d_error`)
-    on ``W = H.T M^-1 H`` and ``q = H.T M^-1 f + w`` of the file, with ``r`` the outcome's
-    impulses in the file's local order. A local file is solved as the `ContactProblem` it is,
-    whose solution carries that error itself: nothing is added for it.
-    """
-    with _opened(path) as (root, form, where, dim):
-        if form == "local":
-            return {}
-        vectors = root["vectors"]
-        mu = _vector(vectors, "mu", f"{where}/vectors")
-        M = _held(_read_matrix(root["M"], f"{where}/M"))
-        H = _held(_read_matrix(root["H"], f"{where}/H"))
-        W = H.T @ _solve(M, as_array(H), where)
-        q = H.T @ _solve(M, _vector(vectors, "f", f"{where}/vectors"), where)
-        q = q + _vector(vectors, "w", f"{where}/vectors")
-    m = mu.size
-    r = np.zeros((m, dim))
-    r[:, 0] = outcome.Pn
-    if outcome.Pt.size:
-        r[:, 1:] = outcome.Pt.reshape(m, dim - 1)
-    return {"fc3d_error": fc3d_error(W, q, mu, r.ravel())}
+    """How ``outcome`` answers the global FCLIB problem of ``path`` (`FileFacts.diagnostics`)."""
+    return read_fclib_file(path).facts.diagnostics(outcome)
 
 
 def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -> Path:

@@ -33,19 +33,24 @@ import json
 import zipfile
 import zlib
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse
 
 from lawbench.core.arrays import is_sparse
 from lawbench.core.contact import ContactProblem
-from lawbench.core.errors import InvalidProblem
+from lawbench.core.errors import InvalidProblem, LawbenchError
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import Contact, ImpactProblem
+from lawbench.files.facts import FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py
 from lawbench.files.paths import MAX_BYTES, input_file, output_file
+
+if TYPE_CHECKING:
+    from lawbench.files.fclib import FclibRead
 
 FORMAT, VERSION = "lawbench-problem", 1
 MATRICES = ("M", "Wn", "Wt", "v", "gaps")
@@ -144,8 +149,9 @@ def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
 def load_problem(path: str | Path) -> ImpactProblem | ContactProblem:
     """Read a problem written by `save_problem` (or by hand, in the same format).
 
-    An HDF5 file holding an FCLIB problem is read as one (`lawbench.files.fclib.read_fclib`):
-    its global form as an `ImpactProblem`, its local form as the `ContactProblem` it is.
+    An HDF5 file holding an FCLIB problem is read as one (`lawbench.files.fclib`): its global
+    form as an `ImpactProblem`, its local form as the `ContactProblem` it is. The problem of
+    `read_problem`, without the facts its reading learned.
 
     Raises
     ------
@@ -153,16 +159,29 @@ def load_problem(path: str | Path) -> ImpactProblem | ContactProblem:
         For an unknown extension, an unreadable or malformed file, or a bad field; the
         message names the file and the field.
     """
+    return read_problem(path).problem
+
+
+def read_problem(path: str | Path) -> ProblemFile:
+    """Read a problem file once: its problem, and what the reading learned of the file.
+
+    The facts (`lawbench.files.facts.FileFacts`) name the file's form (``'lawbench'``, or
+    FCLIB's ``'local'`` or ``'global'``), each matrix's layout on disk, the reformulation
+    applied to an FCLIB global form that is no impact, and, for FCLIB, the file's own ``W``
+    and ``q``: all a caller needs of the file after the read, without opening it again.
+
+    Raises
+    ------
+    InvalidProblem
+        As `load_problem`.
+    NotApplicable
+        For FCLIB's rolling-friction form: no impact law here has rolling resistance.
+    """
     path = input_file(path, "problem file")
     reader = _codec(path)[1]
-    if reader is _read_hdf5:
-        from lawbench.files.fclib import is_fclib, read_fclib
-
-        if is_fclib(path):
-            return read_fclib(path)
     try:
-        data = reader(path)
-    except InvalidProblem:
+        read = reader(path)
+    except LawbenchError:
         raise
     except OSError as exc:
         raise InvalidProblem(f"{path}: cannot be read ({exc.strerror or exc})") from None
@@ -178,23 +197,36 @@ def load_problem(path: str | Path) -> ImpactProblem | ContactProblem:
         # A damaged file: RuntimeError is h5py's word for a broken HDF5 structure, zlib's
         # error an NPZ member that does not inflate.
         raise InvalidProblem(f"{path}: not a lawbench problem file ({exc})") from None
-    return from_dict(data, str(path))
+    return read.interpret()
 
 
 def file_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
-    """What a problem file's own data says of ``outcome``.
+    """What the problem file ``path``'s own data say of ``outcome`` (`FileFacts.diagnostics`).
 
-    For a global FCLIB file its FC3D error (`lawbench.files.fclib.fclib_diagnostics`); nothing
-    for lawbench's own formats, which hold the problem exactly as it is solved, nor for a local
-    FCLIB file, whose contact-space solution carries that error itself.
+    Only an FCLIB file has something to say, and it is read again for it: a caller that has
+    read the file already takes them from its `read_problem` facts instead. Lawbench's own
+    formats hold the problem exactly as it is solved, and are not opened.
     """
     path = Path(path)
-    if _codec(path)[1] is _read_hdf5:
-        from lawbench.files.fclib import fclib_diagnostics, is_fclib
+    if _codec(path)[1] is not _read_hdf5:
+        return {}
+    from lawbench.files.fclib import fclib_diagnostics, fclib_form
 
-        if is_fclib(path):
-            return fclib_diagnostics(path, outcome)
-    return {}
+    return fclib_diagnostics(path, outcome) if fclib_form(path) else {}
+
+
+@dataclass(frozen=True)
+class _Read:
+    """The plain data of a file in lawbench's format and the layout of each matrix in it."""
+
+    data: dict[str, Any]
+    storage: tuple[tuple[str, str], ...]
+    where: Path
+
+    def interpret(self) -> ProblemFile:
+        """The problem the data define, checked field by field (`from_dict`)."""
+        problem = from_dict(self.data, str(self.where))
+        return ProblemFile(problem, FileFacts("lawbench", self.storage))
 
 
 def _json_default(value: Any) -> Any:
@@ -219,7 +251,7 @@ def _write_json(data: dict[str, Any], path: Path) -> None:
     path.write_text(json.dumps(data, default=_json_default, indent=1, allow_nan=False) + "\n")
 
 
-def _read_json(path: Path) -> dict[str, Any]:
+def _read_json(path: Path) -> _Read:
     def reject(name: str) -> float:
         raise InvalidProblem(f"{path}: {name} is not a finite number (a problem holds only those)")
 
@@ -233,7 +265,7 @@ def _read_json(path: Path) -> dict[str, Any]:
         raise InvalidProblem(f"{path}: JSON nested deeper than a problem ever is") from None
     if not isinstance(data, dict):
         raise InvalidProblem(f"{path}: expected a JSON object")
-    return data
+    return _Read(data, tuple((name, "dense") for name in MATRICES if name in data), path)
 
 
 def _arrays(data: dict[str, Any]) -> dict[str, np.ndarray]:
@@ -270,9 +302,10 @@ def _arrays(data: dict[str, Any]) -> dict[str, np.ndarray]:
     return arrays
 
 
-def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> dict[str, Any]:
+def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> _Read:
     """Plain data from the flat arrays of the NPZ or HDF5 file ``where``."""
     data: dict[str, Any] = {}
+    storage: list[tuple[str, str]] = []
     for key in ("format", "version"):
         if key in names:
             value = np.asarray(get(key)).item()
@@ -285,6 +318,7 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> dic
     for name in MATRICES:
         if name in names:
             data[name] = np.asarray(get(name))
+            storage.append((name, "dense"))
         elif f"{name}.data" in names:
             shape = tuple(int(s) for s in np.asarray(get(f"{name}.shape")))
             matrix = scipy.sparse.csr_matrix(
@@ -299,7 +333,8 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> dic
                     f"{where}: field {name!r}: its sparse index arrays are corrupt ({exc})"
                 ) from None
             data[name] = matrix if sparse else matrix.toarray()
-    return data
+            storage.append((name, "compressed rows"))
+    return _Read(data, tuple(storage), where)
 
 
 def _write_npz(data: dict[str, Any], path: Path) -> None:
@@ -307,7 +342,7 @@ def _write_npz(data: dict[str, Any], path: Path) -> None:
         np.savez_compressed(handle, **_arrays(data))
 
 
-def _read_npz(path: Path) -> dict[str, Any]:
+def _read_npz(path: Path) -> _Read:
     with np.load(path, allow_pickle=False) as archive:
         return _from_arrays(lambda key: archive[key], set(archive.files), path)
 
@@ -320,8 +355,13 @@ def _write_hdf5(data: dict[str, Any], path: Path) -> None:
             group.create_dataset(key, data=value.item() if value.dtype.kind == "U" else value)
 
 
-def _read_hdf5(path: Path) -> dict[str, Any]:
+def _read_hdf5(path: Path) -> _Read | FclibRead:
+    """The arrays of an HDF5 file in lawbench's format or FCLIB's, the file opened once."""
+    from lawbench.files.fclib import form_of, read_open
+
     with require_h5py().File(path, "r") as handle:
+        if form_of(handle) is not None:
+            return read_open(handle, str(path))
         if FORMAT not in handle:
             raise InvalidProblem(f"{path}: no group {FORMAT!r} (not a lawbench problem file)")
         group = handle[FORMAT]
@@ -344,4 +384,4 @@ def _codec(path: Path) -> tuple[Callable, Callable]:
         raise InvalidProblem(f"{path}: unknown extension {path.suffix!r}; known: {known}") from None
 
 
-__all__ = ["from_dict", "load_problem", "save_problem", "to_dict"]
+__all__ = ["from_dict", "load_problem", "read_problem", "save_problem", "to_dict"]

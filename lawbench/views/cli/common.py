@@ -1,0 +1,162 @@
+"""What the commands of ``lawbench`` share: the parser, argument types, options and errors."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable, Sequence
+
+from lawbench.core.errors import (
+    InvalidProblem,
+    LawbenchError,
+    NotApplicable,
+    SolverFailure,
+)
+from lawbench.core.registry import Registry
+from lawbench.studies.guard import BUDGET_S, EXECUTORS
+
+
+class Drift(LawbenchError):
+    """Outcomes moved past their baseline tolerance."""
+
+
+class CheckFailed(LawbenchError):
+    """A law fails the common checks (a numerical failure or an unexplained verdict)."""
+
+
+EXIT_CODES = {
+    InvalidProblem: 2,
+    NotApplicable: 3,
+    SolverFailure: 4,
+    CheckFailed: 6,
+    LawbenchError: 5,
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line and exit code 2."""
+
+    def error(self, message: str) -> None:
+        self.exit(2, f"lawbench: {message} (see lawbench --help)\n")
+
+
+# The bounds of the command line's numbers: a count beyond them is a typo or an attack, and a
+# wall-clock limit must be a finite number of seconds.
+MAX_WORKERS = 256
+MAX_REPEATS = 100_000
+MAX_SECONDS = 1e6
+
+
+def _count(low: int, high: int) -> Callable[[str], int]:
+    """An argparse type: an integer within [low, high]."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{value} is outside {low}..{high}")
+        return value
+
+    return parse
+
+
+def _real(accepts: Callable[[float], bool], what: str) -> Callable[[str], float]:
+    """An argparse type: a number that ``accepts`` (``what`` says which, in its message)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not accepts(value):
+            raise argparse.ArgumentTypeError(f"{text}: {what}")
+        return value
+
+    return parse
+
+
+# A wall-clock limit: finite and positive, at most MAX_SECONDS (NaN fails both comparisons).
+_seconds = _real(
+    lambda value: 0 < value <= MAX_SECONDS,
+    f"a wall-clock limit is a number of seconds in (0, {MAX_SECONDS:g}]",
+)
+_tolerance = _real(lambda value: 0 < value < 1, "a tolerance is in (0, 1)")
+_fraction = _real(lambda value: 0 <= value < 1, "a fraction is in [0, 1)")
+
+
+def _path(text: str) -> str:
+    """An argparse type: a path, never empty (an empty one names the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path")
+    return text
+
+
+class _Version(argparse.Action):
+    """``--version``: the installed version, looked up only when asked for."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: object) -> None:
+        from importlib.metadata import version
+
+        print(f"lawbench {version('lawbench')}")
+        parser.exit()
+
+
+def add_assignments(
+    parser: argparse.ArgumentParser, *flags: str, help: str, metavar: str = "NAME=VALUE"
+) -> None:
+    """Add the repeatable option ``flags`` whose values are ``NAME=VALUE`` assignments."""
+    parser.add_argument(*flags, action="append", default=[], metavar=metavar, help=help)
+
+
+def _assignments(items: Sequence[str], flag: str) -> dict[str, str]:
+    values: dict[str, str] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise InvalidProblem(f"{flag} {item!r}: expected NAME=VALUE")
+        if name in values:
+            raise InvalidProblem(f"{flag} {name} is given twice")
+        values[name] = value.strip()
+    return values
+
+
+def _names(text: str | None, option: str, registry: Registry) -> list[str] | None:
+    """The names of a comma-separated option, each known to ``registry``; None when not given.
+
+    ``*`` stands for every registered name.
+
+    Raises
+    ------
+    InvalidProblem
+        For an empty name (``--cases ''``), or `UnknownName` for one the registry does not know.
+    """
+    if text is None:
+        return None
+    names = [name.strip() for name in text.split(",")]
+    if not all(names):
+        raise InvalidProblem(f"{option} {text!r}: an empty name (give names, or leave it out)")
+    for name in names:
+        if name != "*":
+            registry.get(name)
+    return names
+
+
+def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
+    """The options of the commands that run many cells: executor, workers, guard."""
+    parser.add_argument("--executor", choices=EXECUTORS, default=default)
+    parser.add_argument(
+        "--workers",
+        type=_count(1, MAX_WORKERS),
+        help=f"worker processes, at most {MAX_WORKERS} (default: one per core)",
+    )
+    parser.add_argument(
+        "--max-seconds",
+        type=_seconds,
+        default=BUDGET_S,
+        help=f"wall-clock guard of one cell, in seconds (default {BUDGET_S:g})",
+    )

@@ -1,0 +1,163 @@
+"""``lawbench solve LAW CASE``: one law on one scene or problem file, with the checks' verdicts."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+
+from lawbench.checks import run_checks
+from lawbench.checks.study import Job
+from lawbench.core.contact import ContactProblem
+from lawbench.core.errors import InvalidProblem
+from lawbench.core.law import LAWS
+from lawbench.core.transforms import apply
+from lawbench.core.trial import evaluate
+from lawbench.files.facts import ProblemFile
+from lawbench.studies.guard import alarm
+from lawbench.views.cli.common import _assignments, _path, _seconds, add_assignments
+from lawbench.views.serialize import contact_record, trial_record
+
+# Contacts whose impulses the text output of a contact-space solve lists (--json gives all).
+SHOWN_CONTACTS = 10
+
+
+def add(commands: argparse._SubParsersAction) -> None:
+    """Add the ``solve`` command."""
+    solve = commands.add_parser("solve", help="solve one case (or a problem file) with one law")
+    solve.add_argument("law")
+    solve.add_argument("case", nargs="?", help="a scene name (or give --problem FILE)")
+    solve.add_argument(
+        "--problem",
+        type=_path,
+        metavar="FILE",
+        help="a problem file (.json, .npz, .h5): see lawbench export",
+    )
+    add_assignments(solve, "--set", help="a case parameter; a comma-separated value is a list")
+    add_assignments(solve, "--option", help="a law option")
+    solve.add_argument(
+        "--transform",
+        metavar="NAME=VALUE",
+        help="a transform of the built problem (grazing=SPEED, duplicated=CONTACT)",
+    )
+    solve.add_argument(
+        "--max-seconds",
+        type=_seconds,
+        metavar="S",
+        help="stop the solve after S seconds of wall time (exit code 4)",
+    )
+    solve.add_argument("--json", action="store_true", help="print one JSON object")
+    solve.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> None:
+    """Solve, then print the record (text, or one JSON object under ``--json``)."""
+    case, params = _scene_or_problem(args)
+    options = _assignments(args.option, "--option")
+    if isinstance(case, ProblemFile) and isinstance(case.problem, ContactProblem):
+        _solve_contact(args, case, options)
+        return
+    record = _solve(args, case, params, options)
+    if _printed_as_json(args, record):
+        return
+    _print_record(record)
+
+
+def _scene_or_problem(
+    args: argparse.Namespace,
+) -> tuple[str | ProblemFile, dict[str, str]]:
+    """The scene name and its parameters, or the problem file ``--problem FILE`` as read."""
+    params = _assignments(args.set, "--set")
+    if (args.case is None) == (args.problem is None):
+        raise InvalidProblem("give a scene name or --problem FILE (one of the two)")
+    if args.problem is None:
+        return args.case, params
+    if params:
+        raise InvalidProblem("--set gives scene parameters; a problem file is solved as it is")
+    from lawbench.files.problem_files import read_problem
+
+    return read_problem(args.problem), {}
+
+
+def _solve(
+    args: argparse.Namespace,
+    case: str | ProblemFile,
+    params: dict[str, str],
+    options: dict[str, str],
+) -> dict:
+    """The record of ``args.law`` on a scene, or on an impact read from a problem file.
+
+    A file's own data add what they say of the outcome (a global FCLIB form's FC3D error).
+    """
+    with alarm(args.max_seconds):
+        if isinstance(case, str):
+            trial = Job(args.law, case, params, options, args.transform or "").solve()
+        else:
+            trial = evaluate(args.law, apply(args.transform or "", case.problem), options)
+        record = trial_record(trial, run_checks(trial))
+    if isinstance(case, ProblemFile):
+        record["diagnostics"].update(case.facts.diagnostics(trial.outcome))
+    return record
+
+
+def _print_record(record: dict) -> None:
+    """The text output of an impact's solve."""
+    print(f"{record['law']} on {record['case']}  (status: {record['status']})")
+    print(f"{'coordinate':<16}{'v_minus':>14}{'v_plus':>14}")
+    for name, before, after in zip(
+        record["coordinates"], record["v_minus"], record["v_plus"], strict=True
+    ):
+        print(f"{name:<16}{before:>14.6g}{after:>14.6g}")
+    print("Pn: " + ", ".join(f"{p:.6g}" for p in record["Pn"]))
+    if record["Pt"]:
+        print("Pt: " + ", ".join(f"{p:.6g}" for p in record["Pt"]))
+    print(f"T_minus = {record['T_minus']:.6g} J, T_plus = {record['T_plus']:.6g} J")
+    print(f"formulation: {record['diagnostics'].get('formulation')}")
+    if "fc3d_error" in record["diagnostics"]:
+        print(f"FC3D error on the file's own W and q: {record['diagnostics']['fc3d_error']:.3g}")
+    for name, result in record["checks"].items():
+        print(f"  {name:<14}{result['verdict']:<19}{result['detail']}")
+        if result["claim"]:
+            print(f"  {'':<14}{'':<19}{result['claim']}")
+
+
+def _printed_as_json(args: argparse.Namespace, record: dict) -> bool:
+    """Print a solve's warnings under --verbose, and the record under --json: whether it was."""
+    if args.verbose:
+        for heard in record["diagnostics"].get("warnings", ()):
+            print(f"lawbench: warning: {heard}", file=sys.stderr)
+    if args.json:
+        print(json.dumps(record, indent=2, allow_nan=False))
+    return bool(args.json)
+
+
+def _solve_contact(args: argparse.Namespace, read: ProblemFile, options: dict[str, str]) -> None:
+    """``solve LAW --problem FILE`` of a local FCLIB file: the contact-space problem as given."""
+    problem = read.problem
+    if args.transform:
+        raise InvalidProblem(
+            "--transform changes an impact problem; a contact-space problem (FCLIB's local "
+            "form) is solved as it is"
+        )
+    with alarm(args.max_seconds):
+        solution = LAWS.get(args.law).solve_contact(problem, **options)
+    record = contact_record(args.law, problem, solution)
+    if _printed_as_json(args, record):
+        return
+    diagnostics = record["diagnostics"]
+    print(f"{record['law']} on {record['case']}  ({problem.m} contacts, dimension {problem.dim})")
+    print(f"{'contact':<10}{'r (normal, tangents)':<44}{'u (normal, tangents)'}")
+    for j in range(min(problem.m, SHOWN_CONTACTS)):
+        span = slice(j * problem.dim, (j + 1) * problem.dim)
+        print(f"{j:<10}{_numbers(solution.r[span]):<44}{_numbers(solution.u[span])}")
+    if problem.m > SHOWN_CONTACTS:
+        print(f"... {problem.m - SHOWN_CONTACTS} more contacts (--json gives all)")
+    print(f"formulation: {diagnostics.get('formulation')}")
+    print(f"FC3D error on the file's own W and q: {record['fc3d_error']:.3g}")
+    print(f"W's asymmetry max|W - W.T| / max|W|: {read.facts.asymmetry:.3g}")
+    print(f"wall time: {diagnostics['wall_time_s']:.3g} s")
+
+
+def _numbers(values: Sequence[float]) -> str:
+    return ", ".join(f"{value:.6g}" for value in values)
