@@ -564,7 +564,7 @@ def _regress(args: argparse.Namespace) -> None:
 
 
 def _fit(args: argparse.Namespace) -> None:
-    from lawbench.studies.fitting import fit
+    from lawbench.fitting import fit
 
     laws = [name.strip() for name in args.law.split(",") if name.strip()]
     if not laws:
