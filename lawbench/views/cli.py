@@ -502,11 +502,11 @@ def _inline_spec(args: argparse.Namespace) -> object:
 
 def _bench(args: argparse.Namespace) -> None:
     if args.problems is None:
-        from lawbench.studies.bench import report
+        from lawbench.bench import report
 
         print(report(quick=args.quick))
         return
-    from lawbench.studies.bench import (
+    from lawbench.bench import (
         SOLVED_FC3D,
         bench_problems,
         performance_profiles,
