@@ -28,7 +28,8 @@ from lawbench.core.law import LAWS
 def test_the_benchmark_prints_every_figure_with_its_peer():
     text = report(quick=True)
     assert text.startswith("lawbench bench on ")
-    for line in ("one three-ball", "a batch of", "n-ball chain", "bytecode cached"):
+    lines = ("one three-ball", "a batch of", "n-ball chain", "bytecode cached")
+    for line in (*lines, "from its parameters"):
         assert line in text
     integrating = [
         law.name for law in LAWS.values() if any(s.name == "max_events" for s in law.options)
@@ -48,6 +49,7 @@ def test_the_bench_subjects_are_the_ones_laws_and_scenes_declare(monkeypatch):
     assert "lcp" in LAWS[lcp].bench_roles
     law, scene = start_up_command()[1:]
     assert "start_up" in LAWS[law].bench_roles and "start_up" in CASES[scene].bench_roles
+    assert "long_chain" in CASES[subject(CASES, "long_chain")].bench_roles
     monkeypatch.setattr(type(LAWS[lcp]), "bench_roles", ())
     with pytest.raises(InvalidProblem, match="no law declares the bench role 'lcp'"):
         subject(LAWS, "lcp")

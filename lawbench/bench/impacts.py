@@ -33,14 +33,17 @@ from lawbench.bench.timing import (
     row,
 )
 from lawbench.core.batch import ProblemBatch
+from lawbench.core.case import CASES
 from lawbench.core.errors import SolverFailure
 from lawbench.core.law import LAWS
 from lawbench.core.problem import ImpactProblem
-from lawbench.core.trial import solve_batch
+from lawbench.core.trial import solve, solve_batch
 from lawbench.numerics.chains import chain_problem
 
 # Chain lengths of the full report: the growth from 1,000 to 10,000 balls shows the cost per ball.
 CHAINS = (100, 1000, 10_000)
+# Balls of the long-chain scene solved from its parameters.
+SCENE_CHAIN = 1000
 # The integrating laws (those that restart at events: option ``max_events``) on elastic Hertz
 # chains: sizes, the tolerance that keeps a 1000-ball chain's energy to 1e-9, and the
 # wall-clock budget of one run.
@@ -153,6 +156,36 @@ def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) ->
     return lines
 
 
+def chain_from_scene(balls: int, repeats: int) -> list[str]:
+    """The ``lcp`` law on the long-chain scene, from its parameters, against clarabel direct.
+
+    lawbench's time is that of `lawbench.solve` on the scene at ``n = balls``: parameters
+    checked, scene built, solved. clarabel is called directly on the same QP (the built
+    problem's matrices and restitutions), building its matrix and vector included. The law and
+    the scene are those that declare the roles ``lcp`` and ``long_chain``.
+    """
+    law, scene = subject(LAWS, "lcp"), subject(CASES, "long_chain")
+    problem = CASES[scene].build(n=balls)
+    e = np.array([contact.e for contact in problem.contacts])
+    best = alternated(
+        {
+            "scene": lambda: best_time(lambda: solve(law, scene, n=balls), 1),
+            "clarabel direct": lambda: best_time(
+                lambda: clarabel_direct(problem.M, problem.Wn, problem.v, e), 1
+            ),
+        },
+        repeats,
+    )
+    return [
+        f"{law} on the {scene} scene from its parameters (n = {balls}, lawbench.solve):",
+        row(
+            "parameters checked, scene built, solved",
+            best["scene"],
+            {"clarabel direct": best["clarabel direct"]},
+        ),
+    ]
+
+
 def integrating_chains(sizes: tuple[int, ...]) -> list[str]:
     """Each integrating law once on elastic n-ball Hertz chains, one ball striking the rest.
 
@@ -244,6 +277,7 @@ def report(quick: bool = False) -> str:
         *small_impact(repeats),
         *batch_of_impacts(10_000 if quick else 100_000, repeats),
         *(long_chains((100, 1000), repeats) if quick else long_chains(CHAINS, repeats, 1000)),
+        *chain_from_scene(SCENE_CHAIN, repeats),
         *integrating_chains(QUICK_INTEGRATING_SIZES if quick else INTEGRATING_SIZES),
         *start_up(repeats),
     ]

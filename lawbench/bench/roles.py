@@ -15,8 +15,10 @@ ROLES = {
     # the law whose impulses solve the frictionless LCP ``0 <= G z + q _|_ z >= 0`` that the
     # peers (clarabel, the numpy enumeration, Siconos' Lemke) solve;
     "lcp": "the law timed against the LCP peers",
-    # the law and the scene of the small command whose start-up is timed.
+    # the law and the scene of the small command whose start-up is timed;
     "start_up": "the law and scene of the timed start-up command",
+    # the scene of n balls in a row (its parameter ``n``), solved from its parameters.
+    "long_chain": "the n-ball chain scene solved from its parameters",
 }
 
 

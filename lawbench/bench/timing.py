@@ -56,10 +56,11 @@ def chain_arrays(balls: int, rng: np.random.Generator) -> tuple[np.ndarray, ...]
     return np.diag(masses), Wn, v
 
 
-def clarabel_direct(M: Any, Wn: Any, v: np.ndarray, e: float) -> np.ndarray:
+def clarabel_direct(M: Any, Wn: Any, v: np.ndarray, e: float | np.ndarray) -> np.ndarray:
     """Moreau's frictionless impulses with clarabel, called directly on the sparse LCP's QP.
 
-    ``M`` (diagonal) and ``Wn`` are numpy or scipy.sparse arrays.
+    ``M`` (diagonal) and ``Wn`` are numpy or scipy.sparse arrays; ``e`` is one restitution
+    coefficient or one per contact.
     """
     Wn_sparse = scipy.sparse.csc_matrix(Wn)
     inverse_mass = scipy.sparse.diags(1.0 / M.diagonal())
