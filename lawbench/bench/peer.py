@@ -32,8 +32,8 @@ PEER = Path(__file__).with_name("siconos_peer.py")
 # Seconds of calls before a timed peer measures (a fresh process ran a few thousand Lemke
 # solves at two thirds of their steady speed here: 10 us instead of 6.6 us).
 WARM_UP_S = 0.3
-# The longest a timed Lemke or loop measure may take before it counts as failed.
-TIMED_LIMIT_S = 120.0
+# The longest a probe or a timed Lemke or loop measure may take before it counts as failed.
+PEER_LIMIT_S = 120.0
 # Siconos' NSGS as a peer: its sweeps at most.
 SICONOS_SWEEPS = 100_000
 
@@ -88,7 +88,7 @@ def _probed() -> tuple[str, dict[str, Any]] | None:
     """The first interpreter of `candidates` that imports ``siconos.numerics``, and its probe."""
     for python in candidates():
         try:
-            return python, ask(python, {"command": "probe"}, TIMED_LIMIT_S)
+            return python, ask(python, {"command": "probe"}, PEER_LIMIT_S)
         except SolverFailure:
             continue
     return None
@@ -119,7 +119,7 @@ def timed_by(
         return None
     timing = {"warm_up": WARM_UP_S, "repeats": repeats, "number": number}
     try:
-        return float(ask(python, {**request, **timing}, TIMED_LIMIT_S)["seconds"])
+        return float(ask(python, {**request, **timing}, PEER_LIMIT_S)["seconds"])
     except SolverFailure:
         return None
 

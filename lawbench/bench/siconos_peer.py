@@ -28,6 +28,7 @@ thousand Lemke solves slower than its later ones).
 from __future__ import annotations
 
 import json
+import os
 import sys
 import time
 from collections.abc import Callable
@@ -137,4 +138,9 @@ def answer(request: dict[str, Any]) -> dict[str, Any]:
 
 
 if __name__ == "__main__":
-    json.dump(answer(json.load(sys.stdin)), sys.stdout)
+    # Siconos' C code may print on the standard output: it goes to the standard error, and the
+    # answer alone to the standard output, through a copy of it made first.
+    out = os.fdopen(os.dup(sys.stdout.fileno()), "w")
+    os.dup2(sys.stderr.fileno(), sys.stdout.fileno())
+    json.dump(answer(json.load(sys.stdin)), out)
+    out.close()
