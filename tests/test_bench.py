@@ -9,7 +9,7 @@ import pytest
 
 from lawbench.bench import report, start_up_command, subject
 from lawbench.bench.peer import (
-    PEER,
+    PEER_SCRIPT,
     ask,
     candidates,
     siconos_available,
@@ -57,7 +57,7 @@ def test_the_bench_subjects_are_the_ones_laws_and_scenes_declare(monkeypatch):
 
 def test_the_siconos_peer_imports_nothing_of_lawbench():
     """It runs by path in an interpreter where lawbench is not installed."""
-    tree = ast.parse(PEER.read_text(encoding="utf-8"))
+    tree = ast.parse(PEER_SCRIPT.read_text(encoding="utf-8"))
     imported = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
     imported |= {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module}
     assert {name.split(".")[0] for name in imported} <= {

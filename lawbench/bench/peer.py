@@ -28,7 +28,7 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.files.fclib import fclib_form
 from lawbench.numerics.gauss_seidel import in_local_order
 
-PEER = Path(__file__).with_name("siconos_peer.py")
+PEER_SCRIPT = Path(__file__).with_name("siconos_peer.py")
 # Seconds of calls before a timed peer measures (a fresh process ran a few thousand Lemke
 # solves at two thirds of their steady speed here: 10 us instead of 6.6 us).
 WARM_UP_S = 0.3
@@ -49,7 +49,7 @@ def ask(python: str, request: dict[str, Any], timeout: float | None) -> dict[str
     """
     try:
         done = subprocess.run(
-            [python, str(PEER)],
+            [python, str(PEER_SCRIPT)],
             input=json.dumps(request),
             capture_output=True,
             text=True,
