@@ -60,6 +60,7 @@ class BallChain(Case):
     requires = Tags(several_contacts=True)
     ground_truth = SPRINGS
     references = (PLASTIC_CHAIN, NEWTONS_CRADLE)
+    bench_roles = ("long_chain",)
 
     examples = {
         "default": {},

@@ -28,6 +28,7 @@ LAYERS = (
     ("lawbench.checks",),
     ("lawbench.laws", "lawbench.cases"),
     ("lawbench.studies",),
+    ("lawbench.bench", "lawbench.fitting"),
     ("lawbench.views",),
 )
 # Outside the layers: the public names, and ``python -m lawbench``.

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 import lawbench
-from lawbench.studies.fitting import columns
+from lawbench.fitting.trials import columns
 from lawbench.views.cli import main
 
 COLUMNS = ["v1_minus", "v2_minus", "v1_plus", "v2_plus"]

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 import lawbench
 from lawbench.files.fclib import write_fclib
 from lawbench.files.problem_files import load_problem, save_problem
-from lawbench.studies.fitting import read_trials
+from lawbench.fitting.trials import read_trials
 from lawbench.studies.grid import RunSpec
 
 pytest.importorskip("h5py")

@@ -43,7 +43,7 @@ def test_help_lists_every_public_name():
 def test_the_lazy_names_load_only_when_asked_for():
     code = (
         "import sys, lawbench; "
-        "print(sorted(m for m in ('lawbench.views.plotting', 'lawbench.studies.fitting', "
+        "print(sorted(m for m in ('lawbench.views.plotting', 'lawbench.fitting', "
         "'lawbench.files.problem_files', 'lawbench.core.batch') if m in sys.modules))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

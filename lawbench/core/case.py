@@ -115,7 +115,7 @@ class Case(ABC):
     references: ClassVar[tuple[Reference, ...]] = ()
     # Named parameter sets that exercise the scene; every law and check runs on each.
     examples: ClassVar[Mapping[str, Params]] = {"default": {}}
-    # The roles the scene plays in ``lawbench bench`` (`lawbench.studies.bench.ROLES`).
+    # The roles the scene plays in ``lawbench bench`` (`lawbench.bench.roles.ROLES`).
     bench_roles: ClassVar[tuple[str, ...]] = ()
 
     def parameters(self, **given: Any) -> dict[str, Any]:

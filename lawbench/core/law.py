@@ -77,7 +77,7 @@ class Law(ABC):
     # Whether `_resolve` takes a sparse problem (scipy.sparse M, Wn and Delassus matrix); a law
     # that does not receives it with numpy arrays.
     takes_sparse: ClassVar[bool] = False
-    # The roles the law plays in ``lawbench bench`` (`lawbench.studies.bench.ROLES`).
+    # The roles the law plays in ``lawbench bench`` (`lawbench.bench.roles.ROLES`).
     bench_roles: ClassVar[tuple[str, ...]] = ()
     # Whether the law's answer in other units of mass, velocity and time is its answer scaled:
     # true of a law that reads no dimensional contact parameter but the stiffness and the gaps.

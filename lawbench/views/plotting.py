@@ -229,7 +229,7 @@ def plot_profiles(ratios: Mapping[str, Sequence[float]], ax: Axes | None = None)
     ----------
     ratios : mapping of str to sequence of float
         Per solver (``"LAW METHOD"``), its time over the fastest solver's on each problem, inf
-        where it did not solve it (`lawbench.studies.bench.performance_profiles`).
+        where it did not solve it (`lawbench.bench.performance_profiles`).
     ax : matplotlib.axes.Axes, optional
         Where to draw; a new figure's axes when None.
 

@@ -61,7 +61,7 @@ def add(commands: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> None:
     """Print the timing report, or with ``--problems`` bench the folder's files."""
     if args.problems is None:
-        from lawbench.studies.bench import report
+        from lawbench.bench import report
 
         print(report(quick=args.quick))
         return
@@ -70,7 +70,7 @@ def run(args: argparse.Namespace) -> None:
 
 def _bench_problems(args: argparse.Namespace) -> None:
     """Every law on every file of ``--problems``: the CSV table and its performance profiles."""
-    from lawbench.studies.bench import (
+    from lawbench.bench import (
         SOLVED_FC3D,
         bench_problems,
         performance_profiles,

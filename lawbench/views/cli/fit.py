@@ -67,7 +67,7 @@ def add(commands: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> None:
     """Fit each law of ``args.law``; print the results, compared on held-back trials."""
-    from lawbench.studies.fitting import fit
+    from lawbench.fitting import fit
 
     laws = [name.strip() for name in args.law.split(",") if name.strip()]
     if not laws:

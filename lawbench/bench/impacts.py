@@ -1,0 +1,284 @@
+"""``lawbench bench``: the cost of an answer, as ratios against direct solver calls in one run.
+
+Each figure is measured in this process (or as whole processes for the start-up figure) beside
+a peer measured in the same run and timed the same way (`lawbench.bench.timing`): clarabel
+called directly on the same QP, a plain numpy enumeration of the same LCP's active sets, and
+Siconos numerics' Lemke solver where an interpreter here has it (`lawbench.bench.peer`).
+Ratios, not absolute times, are what carry from one machine to another. This is a benchmark:
+nothing here asserts a time.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+
+import clarabel
+import numpy as np
+
+from lawbench.bench.peer import python_loop, siconos_lemke, siconos_python
+from lawbench.bench.roles import start_up_command, subject
+from lawbench.bench.timing import (
+    alternated,
+    best_time,
+    chain_arrays,
+    clarabel_direct,
+    duration,
+    numpy_enumeration,
+    row,
+)
+from lawbench.core.batch import ProblemBatch
+from lawbench.core.case import CASES
+from lawbench.core.errors import SolverFailure
+from lawbench.core.law import LAWS
+from lawbench.core.problem import ImpactProblem
+from lawbench.core.trial import solve, solve_batch
+from lawbench.numerics.chains import chain_problem
+
+# Chain lengths of the full report: the growth from 1,000 to 10,000 balls shows the cost per ball.
+CHAINS = (100, 1000, 10_000)
+# Balls of the long-chain scene solved from its parameters.
+SCENE_CHAIN = 1000
+# The integrating laws (those that restart at events: option ``max_events``) on elastic Hertz
+# chains: sizes, the tolerance that keeps a 1000-ball chain's energy to 1e-9, and the
+# wall-clock budget of one run.
+INTEGRATING_SIZES, QUICK_INTEGRATING_SIZES = (100, 1000), (20, 40)
+INTEGRATING_TOL, INTEGRATING_BUDGET_S = 1e-12, 120.0
+
+
+def small_impact(repeats: int, rounds: int = 3) -> list[str]:
+    """One three-ball impact of the ``lcp`` law: from a prebuilt problem, and from matrices.
+
+    lawbench's two figures, Siconos' and the pure-Python loop in both interpreters are taken in
+    ``rounds`` `alternated` rounds.
+    """
+    M, Wn, v = chain_arrays(3, np.random.default_rng(0))
+    law = LAWS[subject(LAWS, "lcp")]
+    problem = ImpactProblem.from_arrays(M, Wn, v, e=0.9)
+    there = siconos_python()
+    peers = {
+        "clarabel direct": best_time(lambda: clarabel_direct(M, Wn, v, 0.9), repeats, 200),
+        "numpy enumeration": best_time(lambda: numpy_enumeration(M, Wn, v, 0.9), repeats, 200),
+    }
+    measures: dict[str, Callable[[], float | None]] = {
+        "prebuilt": lambda: best_time(lambda: law.resolve(problem), repeats, 1000),
+        "built": lambda: best_time(
+            lambda: law.resolve(ImpactProblem.from_arrays(M, Wn, v, e=0.9)), repeats, 1000
+        ),
+        "Siconos Lemke": lambda: siconos_lemke(np.diag(M), v, repeats, 1000),
+        "loop here": lambda: python_loop(sys.executable, repeats),
+        "loop there": lambda: python_loop(there, repeats),
+    }
+    best = alternated(measures, rounds)
+    siconos = best["Siconos Lemke"]
+    if siconos is not None:
+        peers["Siconos Lemke"] = siconos
+    lines = [
+        f"one three-ball {law.name} impact (e = 0.9):",
+        row("lawbench, prebuilt problem", best["prebuilt"], peers),
+        row("lawbench, from matrices (problem built)", best["built"], peers),
+        *(f"  {name:<46}{duration(t):>12}" for name, t in peers.items()),
+    ]
+    if siconos is None:
+        return [*lines, "  Siconos numerics: not found (python3-siconos)"]
+    ours, theirs = best["loop here"], best["loop there"]
+    if ours is not None and theirs is not None:
+        lines.append(
+            f"  a pure-Python loop: {duration(ours)} in this interpreter (Python "
+            f"{platform.python_version()}), {duration(theirs)} in Siconos' ({there}): "
+            f"{ours / theirs:.2f}x"
+        )
+    return lines
+
+
+def batch_of_impacts(size: int, repeats: int) -> list[str]:
+    """A batch of random three-ball impacts against the one-by-one path and the peers."""
+    rng = np.random.default_rng(1)
+    masses = 10.0 ** rng.uniform(-1.0, 1.0, (size, 3))
+    M = np.einsum("kn,nl->knl", masses, np.eye(3))
+    _, Wn, _ = chain_arrays(3, rng)
+    v = rng.normal(size=(size, 3))
+    e = rng.uniform(0.0, 1.0, (size, 2))
+    law = LAWS[subject(LAWS, "lcp")]
+    whole = best_time(lambda: solve_batch(law, ProblemBatch(M, Wn, v, {"e": e})), repeats)
+    sample = ProblemBatch(M[:200], Wn, v[:200], {"e": e[:200]})
+    one_by_one = (
+        best_time(lambda: [law.resolve(sample.problem(k)) for k in range(200)], repeats) / 200
+    )
+    peers = {
+        "one by one": one_by_one,
+        "clarabel direct": best_time(lambda: clarabel_direct(M[0], Wn, v[0], 0.9), repeats, 200),
+    }
+    siconos = siconos_lemke(masses[0], v[0], repeats)
+    if siconos is not None:
+        peers["Siconos Lemke one by one"] = siconos
+    return [
+        f"a batch of {size:,} random three-ball {law.name} impacts (validation included):",
+        row("lawbench solve_batch, per impact", whole / size, peers),
+    ]
+
+
+def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) -> list[str]:
+    """The ``lcp`` law on n-ball chains, built as the chain scenes build them (sparse when long).
+
+    Against clarabel called directly on the sparse QP and, up to ``siconos_up_to`` balls,
+    Siconos' Lemke on the dense LCP; the last line is the growth exponent of lawbench's time
+    between the two longest chains.
+    """
+    law = LAWS[subject(LAWS, "lcp")]
+    lines = [f"{law.name} on an n-ball chain (e = 0.5):"]
+    times = []
+    for balls in sizes:
+        rng = np.random.default_rng(balls)
+        masses = 10.0 ** rng.uniform(-1.0, 1.0, balls)
+        v = np.sort(rng.uniform(0.0, 1.0, balls))[::-1].copy()
+        ones = [1.0] * (balls - 1)
+        pairs = [(i, i + 1) for i in range(balls - 1)]
+        problem = chain_problem(masses, v, pairs, [0.5] * (balls - 1), ones, ones)
+        peers = {
+            "clarabel direct": best_time(
+                lambda p=problem: clarabel_direct(p.M, p.Wn, p.v, 0.5), repeats
+            )
+        }
+        siconos = siconos_lemke(masses, v, 3, 1, 0.5) if balls <= siconos_up_to else None
+        if siconos is not None:
+            peers["Siconos Lemke"] = siconos
+        times.append(best_time(lambda p=problem: law.resolve(p), repeats))
+        lines.append(row(f"n = {balls}, prebuilt problem", times[-1], peers))
+    if len(sizes) > 1:
+        growth = np.log(times[-1] / times[-2]) / np.log(sizes[-1] / sizes[-2])
+        lines.append(f"  time grows like n^{growth:.2f} from n = {sizes[-2]} to {sizes[-1]}")
+    return lines
+
+
+def chain_from_scene(balls: int, repeats: int) -> list[str]:
+    """The ``lcp`` law on the long-chain scene, from its parameters, against clarabel direct.
+
+    lawbench's time is that of `lawbench.solve` on the scene at ``n = balls``: parameters
+    checked, scene built, solved. clarabel is called directly on the same QP (the built
+    problem's matrices and restitutions), building its matrix and vector included. The law and
+    the scene are those that declare the roles ``lcp`` and ``long_chain``.
+    """
+    law, scene = subject(LAWS, "lcp"), subject(CASES, "long_chain")
+    problem = CASES[scene].build(n=balls)
+    e = np.array([contact.e for contact in problem.contacts])
+    best = alternated(
+        {
+            "scene": lambda: best_time(lambda: solve(law, scene, n=balls), 1),
+            "clarabel direct": lambda: best_time(
+                lambda: clarabel_direct(problem.M, problem.Wn, problem.v, e), 1
+            ),
+        },
+        repeats,
+    )
+    return [
+        f"{law} on the {scene} scene from its parameters (n = {balls}, lawbench.solve):",
+        row(
+            "parameters checked, scene built, solved",
+            best["scene"],
+            {"clarabel direct": best["clarabel direct"]},
+        ),
+    ]
+
+
+def integrating_chains(sizes: tuple[int, ...]) -> list[str]:
+    """Each integrating law once on elastic n-ball Hertz chains, one ball striking the rest.
+
+    The laws are the registered ones that restart at events (option ``max_events``), at
+    tolerance ``INTEGRATING_TOL`` within ``INTEGRATING_BUDGET_S`` seconds. Each line gives
+    the time, the relative energy error ``|T+ - T-| / T-`` (the exact answer keeps the energy),
+    the integrator's steps, or the budget that ran out; the last line of a
+    law, the growth exponent of its time.
+    """
+    laws = [law for law in LAWS.values() if any(spec.name == "max_events" for spec in law.options)]
+    lines = ["integrating laws on an elastic n-ball Hertz chain (e = 1), one run each:"]
+    for law in laws:
+        times = []
+        for balls in sizes:
+            problem = _elastic_chain(balls)
+            start = time.perf_counter()
+            label = f"  {law.name}, n = {balls}, tol = {INTEGRATING_TOL:g}".ljust(48)
+            try:
+                outcome = law.resolve(
+                    problem, tol=INTEGRATING_TOL, max_seconds=INTEGRATING_BUDGET_S
+                )
+            except SolverFailure as failure:
+                lines.append(f"{label}{duration(time.perf_counter() - start):>12}   {failure}")
+                break
+            times.append(time.perf_counter() - start)
+            error = abs(outcome.T_plus - outcome.T_minus) / outcome.T_minus
+            lines.append(
+                f"{label}{duration(times[-1]):>12}   energy error {error:.2g}, "
+                f"{outcome.diagnostics['steps']} integrator steps"
+            )
+        if len(times) > 1:
+            growth = np.log(times[-1] / times[0]) / np.log(sizes[-1] / sizes[0])
+            lines.append(
+                f"  {law.name}: time grows like n^{growth:.2f} from n = {sizes[0]} to {sizes[-1]}"
+            )
+    return lines
+
+
+def _elastic_chain(balls: int) -> ImpactProblem:
+    """Equal balls in contact with Hertz springs, e = 1; the first strikes the others at 1 m/s."""
+    ones = [1.0] * (balls - 1)
+    pairs = [(i, i + 1) for i in range(balls - 1)]
+    velocities = [1.0] + [0.0] * (balls - 1)
+    return chain_problem([1.0] * balls, velocities, pairs, ones, ones, [1.5] * (balls - 1))
+
+
+def start_up(repeats: int) -> list[str]:
+    """Whole-process time of the small command `start_up_command` against importing numpy.
+
+    Both with their bytecode cached, as after a first run (in a temporary
+    ``PYTHONPYCACHEPREFIX``, so that nothing is written beside the sources), and, when this
+    environment sets ``PYTHONDONTWRITEBYTECODE``, as it runs them: every module that has no
+    cached bytecode (an editable install's own) compiled at every start.
+    """
+    command = start_up_command()
+    commands = {
+        "lawbench": [sys.executable, "-m", "lawbench", *command],
+        "numpy": [sys.executable, "-c", "import numpy"],
+    }
+
+    def pair(label: str, env: dict[str, str]) -> str:
+        def timed(command: list[str]) -> Callable[[], float]:
+            def run() -> None:
+                subprocess.run(command, capture_output=True, check=True, env=env)
+
+            run()  # a first run fills the cache
+            return lambda: best_time(run, 1)
+
+        best = alternated({name: timed(command) for name, command in commands.items()}, repeats)
+        return row(label, best["lawbench"], {'python -c "import numpy"': best["numpy"]})
+
+    lines = [f"start-up, whole process, lawbench {' '.join(command)}:"]
+    with tempfile.TemporaryDirectory() as cache:
+        cached = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+        lines.append(pair("bytecode cached", {**cached, "PYTHONPYCACHEPREFIX": cache}))
+    if os.environ.get("PYTHONDONTWRITEBYTECODE"):
+        lines.append(pair("no bytecode cache (PYTHONDONTWRITEBYTECODE)", dict(os.environ)))
+    return lines
+
+
+def report(quick: bool = False) -> str:
+    """Every figure, as text."""
+    repeats = 3 if quick else 7
+    threads = {k: os.environ.get(k, "unset") for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
+    lines = [
+        f"lawbench bench on {os.cpu_count()} cores, {platform.machine()}, Python "
+        f"{platform.python_version()}, numpy {np.__version__}, clarabel {clarabel.__version__}; "
+        + ", ".join(f"{k}={v}" for k, v in threads.items()),
+        *small_impact(repeats),
+        *batch_of_impacts(10_000 if quick else 100_000, repeats),
+        *(long_chains((100, 1000), repeats) if quick else long_chains(CHAINS, repeats, 1000)),
+        *chain_from_scene(SCENE_CHAIN, repeats),
+        *integrating_chains(QUICK_INTEGRATING_SIZES if quick else INTEGRATING_SIZES),
+        *start_up(repeats),
+    ]
+    return "\n".join(lines)
