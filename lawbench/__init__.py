@@ -3,7 +3,7 @@
 The entry points share one convention, ``(law, scene name or problem, **params,
 options=...)``: `solve` returns the `Outcome`, `evaluate` the whole `Trial`, `run_checks` the
 verdict of every check (it also takes a trial alone). Laws, scenes and studies are in the
-read-only registries `LAWS`, `CASES` and ``lawbench.checks.declared.STUDIES``; every check's
+read-only registries `LAWS`, `CASES` and ``lawbench.studies.declared.STUDIES``; every check's
 result carries a `Verdict`. `solve_batch` solves many problems of one shape, `fit` identifies
 a law's coefficients from measured velocities, `check_law` holds any law to the common checks,
 `load_problem` and `save_problem` read and write problem files, `load_run` reads a run table.

@@ -1,6 +1,6 @@
 """The executor: every study cell and every ``lawbench run`` row, one record each, one guard.
 
-`compute` solves one cell (`lawbench.checks.study.Job`), runs its checks and measures, and returns
+`compute` solves one cell (`lawbench.studies.study.Job`), runs its checks and measures, and returns
 its `lawbench.studies.record.Record` row; it never raises: a failure is recorded with its error
 class and message and the run goes on (nevergrad's runner does the same). An `Executor` runs cells
 in this process (``serial``), in local worker processes (``processes``) or on a Dask cluster
@@ -32,7 +32,6 @@ import pandas as pd
 from tqdm import tqdm
 
 from lawbench.checks import run_checks
-from lawbench.checks.study import Job, Measure, Plan
 from lawbench.core.errors import InvalidProblem
 from lawbench.files.paths import output_file
 from lawbench.studies.guard import (
@@ -47,6 +46,7 @@ from lawbench.studies.guard import (
 )
 from lawbench.studies.record import Record
 from lawbench.studies.runfile import Store, file_format, metadata
+from lawbench.studies.study import Job, Measure, Plan
 
 
 class WorkerDied(Exception):

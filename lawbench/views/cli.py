@@ -18,8 +18,6 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from lawbench.checks import run_checks
-from lawbench.checks.declared import STUDIES
-from lawbench.checks.study import Job
 from lawbench.core.case import CASES, Case
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import (
@@ -35,7 +33,9 @@ from lawbench.core.registry import Registry
 from lawbench.core.transforms import apply
 from lawbench.core.trial import evaluate
 from lawbench.files.paths import output_file, output_folder
+from lawbench.studies.declared import STUDIES
 from lawbench.studies.guard import BUDGET_S, EXECUTORS, alarm
+from lawbench.studies.study import Job
 from lawbench.views.serialize import contact_record, trial_record
 
 
