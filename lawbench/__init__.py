@@ -14,9 +14,12 @@ form, ``W``, ``q``, ``mu`` as given), solved by a law's ``solve_contact`` into a
 The package is built in layers, each importing only those below it::
 
     views      command line, report, figures           (lawbench.views)
-    studies    grids, runs, tables, baselines, fits    (lawbench.studies)
-    laws, cases                                          (lawbench.laws, lawbench.cases)
-    checks     checks, measures, regions, studies as data (lawbench.checks)
+    bench, fitting   the benchmark, fits to measurements (lawbench.bench, lawbench.fitting)
+    studies    the study engine: studies built from their declarations, grids, runs,
+               tables, baselines                       (lawbench.studies)
+    laws, cases  laws and scenes, their studies declared as data
+                                                         (lawbench.laws, lawbench.cases)
+    checks     checks, measures, regions               (lawbench.checks)
     numerics, files                                      (lawbench.numerics, lawbench.files)
     core       problem, outcome, law, case, registries, errors, verdicts (lawbench.core)
 
