@@ -77,8 +77,9 @@ def extremes(
 ) -> Study:
     """One axis of the stability grid: every law on ``case`` pushed along ``axis``.
 
-    The study is called ``CASE_NAME``. ``axis`` is a grid parameter, a measure, or
-    ``transform``; every single-solve check decides the cells.
+    The study is called after the scene and ``name`` (``three_ball_chain_stiffness``).
+    ``axis`` is a grid parameter, a measure, or ``transform``; every single-solve check decides
+    the cells.
     """
     return Study(
         name=f"{case}_{name}",
