@@ -1,7 +1,9 @@
-"""What the chain scenes share besides their problem: closed forms and their ground truth.
+"""What the chain scenes share besides their problem: closed forms, ground truth and studies.
 
-`lawbench.numerics.chains` builds the problems; this module holds the references of free chains and
-the ground truth of every chain scene (compliant integration at the scene's stiffnesses).
+`lawbench.numerics.chains` builds the problems; this module holds the references of free chains,
+the ground truth of every chain scene (compliant integration at the scene's stiffnesses) and the
+studies the chain scenes declare alike (as data, `lawbench.studies.declared`), each run with
+every contact elastic and with every contact plastic.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.checks.knobs import decades
 from lawbench.core.case import GroundTruth, Reference
 
 SPRINGS = GroundTruth(
@@ -77,3 +80,60 @@ NEWTONS_CRADLE = Reference(
     v_plus=lambda p: np.eye(len(p["masses"]))[-1] * p["velocities"][0],
     condition=_cradle_condition,
 )
+
+
+# The restitutions every stability study of a chain is run at: elastic and plastic.
+ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
+
+
+def masses_extremes(title: str, others: int, **more: Any) -> dict[str, Any]:
+    """The stability study along the striker's mass, 1e-6 to 1e6 kg, ``others`` balls of 1 kg.
+
+    ``more`` are further arguments of the ``extremes`` shape (fixed parameters, laws).
+    """
+
+    def grid(step: int) -> dict[str, list]:
+        return {
+            "masses": [[r] + [1.0] * others for r in decades(-6, 6, step)],
+            **ELASTIC_AND_PLASTIC,
+        }
+
+    return {
+        "shape": "extremes",
+        "name": "masses",
+        "title": title,
+        "axis": "masses",
+        "grid": grid(3),
+        **more,
+        "full": {"grid": grid(1)},
+    }
+
+
+def two_contact_studies(stiffness_title: str, **shares: str) -> tuple[dict[str, Any], ...]:
+    """The studies of a chain of two contacts whose stiffness ratio is a parameter.
+
+    Its stiffness ratio pushed over eight decades (sixteen in the full report; its meaning in
+    ``stiffness_title``), a grazing approach and contact 0 given twice, each elastic and plastic;
+    the speed/accuracy trade; the energy shares per body over the stiffness ratio (``shares``:
+    the study's ``name`` when not the default) and the continuity sweep.
+    """
+    return (
+        {
+            "shape": "extremes",
+            "name": "stiffness",
+            "title": stiffness_title,
+            "axis": "stiffness_ratio",
+            "grid": {"stiffness_ratio": decades(-4, 4, 4), **ELASTIC_AND_PLASTIC},
+            "full": {"grid": {"stiffness_ratio": decades(-8, 8), **ELASTIC_AND_PLASTIC}},
+        },
+        {"shape": "grazing", "e": ELASTIC_AND_PLASTIC["e"]},
+        {"shape": "duplicated_contact", "e": ELASTIC_AND_PLASTIC["e"]},
+        {"shape": "speed_accuracy"},
+        {
+            "shape": "energy_shares",
+            "ratios": decades(-3, 3, 2),
+            "full_ratios": np.logspace(-3, 3, 25).tolist(),
+            **shares,
+        },
+        {"shape": "continuity"},
+    )

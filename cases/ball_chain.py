@@ -16,8 +16,13 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
-from lawbench.checks.declared import STUDIES, decades, extremes, speed_accuracy
+from lawbench.cases._chains import (
+    ELASTIC_AND_PLASTIC,
+    NEWTONS_CRADLE,
+    PLASTIC_CHAIN,
+    SPRINGS,
+    masses_extremes,
+)
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.problem import ImpactProblem
@@ -109,28 +114,17 @@ class BallChain(Case):
 CASES.register(BallChain())
 
 
-_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
-STUDIES.register(
-    extremes(
-        "ball_chain_length",
-        "chain length [balls]",
-        "ball_chain",
-        "n",
-        grid={"n": [100], **_ELASTIC_AND_PLASTIC},
-        full={"grid": {"n": [10, 100, 1000], **_ELASTIC_AND_PLASTIC}},
-    )
+# The studies this scene declares, as data; the masses on two balls, one contact: every law,
+# those that treat one contact only included.
+BallChain.studies = (
+    {
+        "shape": "extremes",
+        "name": "length",
+        "title": "chain length [balls]",
+        "axis": "n",
+        "grid": {"n": [100], **ELASTIC_AND_PLASTIC},
+        "full": {"grid": {"n": [10, 100, 1000], **ELASTIC_AND_PLASTIC}},
+    },
+    masses_extremes("striker's mass [kg], the struck ball 1 kg", 1, params={"n": 2}, laws="able"),
+    {"shape": "speed_accuracy"},
 )
-# Two balls, one contact: every law, those that treat one contact only included.
-STUDIES.register(
-    extremes(
-        "ball_chain_masses",
-        "striker's mass [kg], the struck ball 1 kg",
-        "ball_chain",
-        "masses",
-        grid={"masses": [[r, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
-        params={"n": 2},
-        laws="able",
-        full={"grid": {"masses": [[r, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
-    )
-)
-STUDIES.register(speed_accuracy("ball_chain"))

@@ -25,7 +25,6 @@ from typing import Any
 
 from lawbench.cases import _specs
 from lawbench.cases._chains import SPRINGS
-from lawbench.checks.declared import STUDIES, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
@@ -77,4 +76,5 @@ class BeadColumn(Case):
 
 CASES.register(BeadColumn())
 
-STUDIES.register(speed_accuracy("bead_column"))
+# The studies this scene declares, as data.
+BeadColumn.studies = ({"shape": "speed_accuracy"},)

@@ -42,8 +42,6 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import STUDIES, speed_accuracy
-from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, Params, Reference, per_item
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.problem import Contact, ImpactProblem
@@ -298,57 +296,51 @@ UNITS = {
     "curvature": "1/m",
 }
 
-STUDIES.register(
-    Study(
-        name="billiard",
-        title="billiard shot with a side offset of 12 mm: the ball's velocity (vx, vy, vz; m/s), "
-        "speed (m/s), spin (wx, wy, wz; rad/s) and the tilt of its spin axis above the table "
-        "(degrees) and the curvature of its path on the cloth (1/m) against the cue's elevation "
-        "(degrees)",
-        cases=("billiard",),
-        grid={"elevation": [0.0, 30.0, 60.0, 75.0]},
-        params={"offset_side": 0.012},
-        measures=MEASURES,
-        axes=("elevation",),
-        units=UNITS,
-        view="sweep",
-        full={"grid": {"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 70.0, 75.0, 80.0]}},
-    )
-)
-STUDIES.register(
-    Study(
-        name="billiard_offset",
-        title="masse shot at 60 degrees of elevation: the ball's velocity (m/s), speed (m/s), "
+# The studies this scene declares, as data.
+Billiard.studies = (
+    {
+        "shape": "sweep",
+        "name": "billiard",
+        "title": "billiard shot with a side offset of 12 mm: the ball's velocity (vx, vy, vz; "
+        "m/s), speed (m/s), spin (wx, wy, wz; rad/s) and the tilt of its spin axis above the "
+        "table (degrees) and the curvature of its path on the cloth (1/m) against the cue's "
+        "elevation (degrees)",
+        "grid": {"elevation": [0.0, 30.0, 60.0, 75.0]},
+        "params": {"offset_side": 0.012},
+        "measures": MEASURES,
+        "axes": ("elevation",),
+        "units": UNITS,
+        "full": {"grid": {"elevation": [0.0, 15.0, 30.0, 45.0, 60.0, 70.0, 75.0, 80.0]}},
+    },
+    {
+        "shape": "sweep",
+        "name": "billiard_offset",
+        "title": "masse shot at 60 degrees of elevation: the ball's velocity (m/s), speed (m/s), "
         "spin (rad/s), spin-axis tilt (degrees) and path curvature (1/m) against the cue's "
         "sideways offset (m), -12 mm (left english) to 12 mm",
-        cases=("billiard",),
-        grid={"offset_side": [-0.012, 0.0, 0.012]},
-        params={"elevation": 60.0},
-        measures=MEASURES,
-        axes=("offset_side",),
-        units=UNITS,
-        view="sweep",
-        full={
+        "grid": {"offset_side": [-0.012, 0.0, 0.012]},
+        "params": {"elevation": 60.0},
+        "measures": MEASURES,
+        "axes": ("offset_side",),
+        "units": UNITS,
+        "full": {
             "grid": {
                 "offset_side": [-0.012, -0.009, -0.006, -0.003, 0.0, 0.003, 0.006, 0.009, 0.012]
             }
         },
-    )
+    },
+    {
+        "shape": "table_path",
+        "name": "billiard_masse",
+        "title": "masse shot (elevation 70 degrees, offsets 12 mm sideways and 5 mm up): the "
+        "ball's path on the cloth (m) during its first second, sliding on a parabola until it "
+        "rolls, for every law that treats the shot, as the cue's compliance changes (stiffness "
+        "of the ball-table contact over the cue-ball one, 0.1 to 10: a soft tip to a hard one)",
+        "grid": {"stiffness_ratio": [0.1, 1.0, 10.0]},
+        "params": {"elevation": 70.0, "offset_side": 0.012, "offset_height": 0.005},
+        "measures": {"table_path": table_path, "curvature": path_curvature},
+        "axes": ("stiffness_ratio",),
+        "units": {"table_path": "m", "curvature": "1/m"},
+    },
+    {"shape": "speed_accuracy"},
 )
-STUDIES.register(
-    Study(
-        name="billiard_masse",
-        title="masse shot (elevation 70 degrees, offsets 12 mm sideways and 5 mm up): the ball's "
-        "path on the cloth (m) during its first second, sliding on a parabola until it rolls, "
-        "for every law that treats the shot, as the cue's compliance changes (stiffness of "
-        "the ball-table contact over the cue-ball one, 0.1 to 10: a soft tip to a hard one)",
-        cases=("billiard",),
-        grid={"stiffness_ratio": [0.1, 1.0, 10.0]},
-        params={"elevation": 70.0, "offset_side": 0.012, "offset_height": 0.005},
-        measures={"table_path": table_path, "curvature": path_curvature},
-        axes=("stiffness_ratio",),
-        units={"table_path": "m", "curvature": "1/m"},
-        view="table_path",
-    )
-)
-STUDIES.register(speed_accuracy("billiard"))

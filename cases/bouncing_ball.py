@@ -35,7 +35,6 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import STUDIES, large_friction, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, Reference, exactly
 from lawbench.core.problem import MINDLIN_RATIO, Contact, ImpactProblem
 from lawbench.core.spec import Spec
@@ -199,5 +198,5 @@ class BouncingBall(Case):
 
 BouncingBall.references = (frictionless_reference(BouncingBall),)
 CASES.register(BouncingBall())
-STUDIES.register(large_friction("bouncing_ball"))
-STUDIES.register(speed_accuracy("bouncing_ball"))
+# The studies this scene declares, as data.
+BouncingBall.studies = ({"shape": "large_friction"}, {"shape": "speed_accuracy"})

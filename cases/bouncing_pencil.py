@@ -43,7 +43,6 @@ from lawbench.cases.bouncing_ball import (
     frictionless_reference,
     vector_spec,
 )
-from lawbench.checks.declared import STUDIES, large_friction, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, exactly
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
@@ -139,5 +138,5 @@ class BouncingPencil(Case):
 
 BouncingPencil.references = (frictionless_reference(BouncingPencil),)
 CASES.register(BouncingPencil())
-STUDIES.register(large_friction("bouncing_pencil"))
-STUDIES.register(speed_accuracy("bouncing_pencil"))
+# The studies this scene declares, as data.
+BouncingPencil.studies = ({"shape": "large_friction"}, {"shape": "speed_accuracy"})

@@ -51,8 +51,6 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import STUDIES, impact_paths, speed_accuracy
-from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.problem import Contact, ImpactProblem
@@ -207,44 +205,42 @@ def stored_energy_peaks(trial: Any) -> list[float] | None:
     return np.asarray(path["stored_energy"]).max(axis=0).tolist()
 
 
-STUDIES.register(
-    Study(
-        name="disk_ball",
-        title="disk struck by a ball at height b (m) on its axis, r = 5 cm: disk translation "
+# The studies this scene declares, as data.
+DiskBall.studies = (
+    {
+        "shape": "sweep",
+        "name": "disk_ball",
+        "title": "disk struck by a ball at height b (m) on its axis, r = 5 cm: disk translation "
         "vyd+/vb, rotation r omega+/vb, ball rebound vyb+/vb and dT/T- for every law that "
         "treats it",
-        cases=("disk_ball",),
-        laws="covering",
-        grid={"b": np.linspace(-0.045, 0.045, 7).tolist()},
-        measures={
+        "laws": "covering",
+        "grid": {"b": np.linspace(-0.045, 0.045, 7).tolist()},
+        "measures": {
             "disk_translation": disk_translation,
             "disk_rotation": disk_rotation,
             "ball_rebound": ball_rebound,
             "energy_change": energy_change,
             "primary_contacts": primary_contacts,
         },
-        checks=("energy_gain", "admissible", "friction_cone"),
-        axes=("b", "disk_translation", "disk_rotation", "ball_rebound", "energy_change"),
-        units=dict.fromkeys(
+        "checks": ("energy_gain", "admissible", "friction_cone"),
+        "axes": ("b", "disk_translation", "disk_rotation", "ball_rebound", "energy_change"),
+        "units": dict.fromkeys(
             ("disk_translation", "disk_rotation", "ball_rebound", "energy_change"), ""
         ),
-        view="sweep",
-    )
+    },
+    {
+        "shape": "impact_paths",
+        "name": "disk_ball_energies",
+        "title": "disk struck low, at the centre and high (b = -4.5, 0, 4.5 cm): the stored "
+        "energy per contact along the impact (contacts 0-2 the floor points A, B, C; 3 the ball "
+        "D), of the energetic law (Zhang et al. 2013, its central figure) against its "
+        "impulse-time variable, and of the compliant ground truth against time; the energetic "
+        "law's primary contacts",
+        "laws": ("lzb", "compliant"),
+        "axis": "b",
+        "values": [-0.045, 0.0, 0.045],
+        "quantities": ("stored_energy",),
+        "extra": {"stored_energy_peaks": stored_energy_peaks, "primary_contacts": primary_contacts},
+    },
+    {"shape": "speed_accuracy"},
 )
-STUDIES.register(
-    impact_paths(
-        "disk_ball_energies",
-        "disk struck low, at the centre and high (b = -4.5, 0, 4.5 cm): the stored energy per "
-        "contact along the impact (contacts 0-2 the floor points A, B, C; 3 the ball D), of "
-        "the energetic law (Zhang et al. 2013, its central figure) against its impulse-time "
-        "variable, and of the compliant ground truth against time; the energetic law's "
-        "primary contacts",
-        ("lzb", "compliant"),
-        "disk_ball",
-        "b",
-        [-0.045, 0.0, 0.045],
-        ("stored_energy",),
-        {"stored_energy_peaks": stored_energy_peaks, "primary_contacts": primary_contacts},
-    )
-)
-STUDIES.register(speed_accuracy("disk_ball"))

@@ -35,7 +35,6 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import STUDIES, energy_map, large_friction, speed_accuracy
 from lawbench.core.case import CASES, Case, Params, exactly
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
@@ -136,6 +135,9 @@ class DoublePendulum(Case):
 
 CASES.register(DoublePendulum())
 
-STUDIES.register(energy_map("double_pendulum", ("e", 0.0, 1.0), ("mu", 0.0, 1.5)))
-STUDIES.register(large_friction("double_pendulum"))
-STUDIES.register(speed_accuracy("double_pendulum"))
+# The studies this scene declares, as data.
+DoublePendulum.studies = (
+    {"shape": "energy_map", "x": ("e", 0.0, 1.0), "y": ("mu", 0.0, 1.5)},
+    {"shape": "large_friction"},
+    {"shape": "speed_accuracy"},
+)

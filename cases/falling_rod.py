@@ -48,14 +48,6 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import (
-    STUDIES,
-    duplicated_contact,
-    energy_map,
-    grazing,
-    large_friction,
-    speed_accuracy,
-)
 from lawbench.core.case import CASES, Case, Params, Reference, exactly
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
@@ -250,11 +242,11 @@ CASES.register(FallingRod())
 
 
 _GAIN = {k: v for k, v in FallingRod.examples["energy gain"].items() if k not in ("angle", "mu")}
-for study in (
-    speed_accuracy("falling_rod"),
-    energy_map("falling_rod", ("angle", 5.0, 85.0), ("mu", 0.0, 1.5), params=_GAIN),
-    large_friction("falling_rod"),
-    grazing("falling_rod", [0.0, 1.0]),
-    duplicated_contact("falling_rod", [0.0, 1.0]),
-):
-    STUDIES.register(study)
+# The studies this scene declares, as data.
+FallingRod.studies = (
+    {"shape": "speed_accuracy"},
+    {"shape": "energy_map", "x": ("angle", 5.0, 85.0), "y": ("mu", 0.0, 1.5), "params": _GAIN},
+    {"shape": "large_friction"},
+    {"shape": "grazing", "e": [0.0, 1.0]},
+    {"shape": "duplicated_contact", "e": [0.0, 1.0]},
+)

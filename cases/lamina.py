@@ -31,13 +31,6 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import (
-    STUDIES,
-    duplicated_contact,
-    grazing,
-    large_friction,
-    speed_accuracy,
-)
 from lawbench.core.case import CASES, Case, Params, Reference
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
@@ -164,10 +157,10 @@ class Lamina(Case):
 CASES.register(Lamina())
 
 
-for study in (
-    speed_accuracy("lamina"),
-    large_friction("lamina"),
-    grazing("lamina", [0.0, 1.0]),
-    duplicated_contact("lamina", [0.0, 1.0]),
-):
-    STUDIES.register(study)
+# The studies this scene declares, as data.
+Lamina.studies = (
+    {"shape": "speed_accuracy"},
+    {"shape": "large_friction"},
+    {"shape": "grazing", "e": [0.0, 1.0]},
+    {"shape": "duplicated_contact", "e": [0.0, 1.0]},
+)

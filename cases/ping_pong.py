@@ -46,8 +46,6 @@ from typing import Any
 import numpy as np
 
 from lawbench.cases.two_balls_wall import TwoBallsWall
-from lawbench.checks.declared import STUDIES, speed_accuracy
-from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Params
 from lawbench.core.spec import Spec
 from lawbench.numerics.chains import (
@@ -126,19 +124,19 @@ def rebound_ratio_2(trial: Any) -> float:
     return float(trial.outcome.v_plus[1] / np.abs(trial.problem.v).max())
 
 
-STUDIES.register(
-    Study(
-        name="ping_pong",
-        title="ping-pong stack dropped at v0 = 1 m/s: v1+/v0 and v2+/v0 at the measured "
+# The studies this scene declares, as data (its own: none of those of the two balls on a wall).
+PingPong.studies = (
+    {
+        "shape": "sweep",
+        "name": "ping_pong",
+        "title": "ping-pong stack dropped at v0 = 1 m/s: v1+/v0 and v2+/v0 at the measured "
         "e1 = 0.950043, e2 = 0.846529 and the guessed k2/k1 = 3, then k2/k1 from 1/10 to 10",
-        cases=("ping_pong",),
-        laws=("jia", "lzb", "compliant", "sequential"),
-        grid={"stiffness_ratio": [GUESSED_RATIO, 0.1, 0.3, 1.0, 10.0]},
-        measures={"v1_over_v0": rebound_ratio_1, "v2_over_v0": rebound_ratio_2},
-        checks=("energy_gain", "admissible"),
-        axes=("stiffness_ratio",),
-        units={"v1_over_v0": "", "v2_over_v0": ""},
-        view="sweep",
-    )
+        "laws": ("jia", "lzb", "compliant", "sequential"),
+        "grid": {"stiffness_ratio": [GUESSED_RATIO, 0.1, 0.3, 1.0, 10.0]},
+        "measures": {"v1_over_v0": rebound_ratio_1, "v2_over_v0": rebound_ratio_2},
+        "checks": ("energy_gain", "admissible"),
+        "axes": ("stiffness_ratio",),
+        "units": {"v1_over_v0": "", "v2_over_v0": ""},
+    },
+    {"shape": "speed_accuracy"},
 )
-STUDIES.register(speed_accuracy("ping_pong"))

@@ -46,8 +46,6 @@ from typing import Any
 import numpy as np
 
 from lawbench.cases import _specs
-from lawbench.checks.declared import STUDIES, large_friction, speed_accuracy
-from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, GroundTruth, Params, Reference
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.tags import Tags
@@ -220,22 +218,22 @@ def from_housner(trial: Trial) -> float:
     return omega_ratio(trial) - housner(trial)
 
 
-STUDIES.register(
-    Study(
-        name="rocking_block",
-        title="rocking block: omega+/omega- against Housner's 1 - 3/2 sin^2(alpha), e = 0, "
+# The studies this scene declares, as data.
+RockingBlock.studies = (
+    {
+        "shape": "sweep",
+        "name": "rocking_block",
+        "title": "rocking block: omega+/omega- against Housner's 1 - 3/2 sin^2(alpha), e = 0, "
         "height 1 m, width 0.1 to 10 m (so width/height 0.1 to 10), mu in {0, 1}; Housner's "
         "formula holds for width <= sqrt(2) height (wider, the pivot cannot lift off)",
-        cases=("rocking_block",),
-        laws="every",
-        grid={"mu": [0.0, 1.0], "width": np.logspace(-1.0, 1.0, 5).tolist()},
-        params={"height": 1.0, "e": 0.0},
-        measures={"omega_ratio": omega_ratio, "housner": housner, "difference": from_housner},
-        axes=("width", "omega_ratio", "difference"),
-        units={"omega_ratio": "", "difference": ""},
-        view="sweep",
-        full={"grid": {"mu": [0.0, 1.0], "width": np.logspace(-1.0, 1.0, 17).tolist()}},
-    )
+        "laws": "every",
+        "grid": {"mu": [0.0, 1.0], "width": np.logspace(-1.0, 1.0, 5).tolist()},
+        "params": {"height": 1.0, "e": 0.0},
+        "measures": {"omega_ratio": omega_ratio, "housner": housner, "difference": from_housner},
+        "axes": ("width", "omega_ratio", "difference"),
+        "units": {"omega_ratio": "", "difference": ""},
+        "full": {"grid": {"mu": [0.0, 1.0], "width": np.logspace(-1.0, 1.0, 17).tolist()}},
+    },
+    {"shape": "large_friction"},
+    {"shape": "speed_accuracy"},
 )
-STUDIES.register(large_friction("rocking_block"))
-STUDIES.register(speed_accuracy("rocking_block"))

@@ -32,8 +32,6 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
-from lawbench.checks.declared import STUDIES, grazing, large_friction, speed_accuracy
-from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case, Params, Reference, exactly
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
@@ -180,31 +178,31 @@ def impulse_ratio(trial: Trial) -> float:
 
 
 _DEFAULTS = SphereWall().parameters()
-STUDIES.register(
-    Study(
-        name="sphere_wall",
-        title="sphere on a wall, no pre-impact spin, incidence 5 to 85 degrees: post-impact "
+# The studies this scene declares, as data. The quick report grazes at 1e-12 m/s alone: from
+# 1e-4 to 1e-8 m/s the spatial slip of the integrating laws turns stiffly and takes seconds a
+# cell (every decade in the full report).
+SphereWall.studies = (
+    {
+        "shape": "sweep",
+        "name": "sphere_wall",
+        "title": "sphere on a wall, no pre-impact spin, incidence 5 to 85 degrees: post-impact "
         "slip ut_plus (m/s) along the pre-impact slip, spin about n x s (rad/s), impulse ratio "
         f"-Pt.s/Pn; e = {_DEFAULTS['e']:g}, e_t = {_DEFAULTS['e_t']:g}, "
         f"mu = {_DEFAULTS['mu']:g}, speed = {_DEFAULTS['speed']:g} m/s, "
         f"radius = {_DEFAULTS['radius']:g} m",
-        cases=("sphere_wall",),
-        laws=("brach", "whittaker", "darboux_keller"),
-        grid={"angle": np.linspace(5.0, 85.0, 9).tolist()},
-        params={"spin": [0.0, 0.0, 0.0]},
-        measures={
+        "laws": ("brach", "whittaker", "darboux_keller"),
+        "grid": {"angle": np.linspace(5.0, 85.0, 9).tolist()},
+        "params": {"spin": [0.0, 0.0, 0.0]},
+        "measures": {
             "ut_minus": slip_before,
             "ut_plus": slip_after,
             "spin_plus": spin_after,
             "impulse_ratio": impulse_ratio,
         },
-        axes=("angle", "ut_plus", "spin_plus", "impulse_ratio"),
-        units={"ut_plus": "m/s", "spin_plus": "rad/s", "impulse_ratio": ""},
-        view="sweep",
-    )
+        "axes": ("angle", "ut_plus", "spin_plus", "impulse_ratio"),
+        "units": {"ut_plus": "m/s", "spin_plus": "rad/s", "impulse_ratio": ""},
+    },
+    {"shape": "large_friction"},
+    {"shape": "grazing", "e": [0.0, 1.0], "values": (1e-12,)},
+    {"shape": "speed_accuracy"},
 )
-STUDIES.register(large_friction("sphere_wall"))
-# The quick report grazes at 1e-12 m/s alone: from 1e-4 to 1e-8 m/s the spatial slip of the
-# integrating laws turns stiffly and takes seconds a cell (every decade in the full report).
-STUDIES.register(grazing("sphere_wall", [0.0, 1.0], values=(1e-12,)))
-STUDIES.register(speed_accuracy("sphere_wall"))

@@ -13,16 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases._chains import NEWTONS_CRADLE, PLASTIC_CHAIN, SPRINGS
-from lawbench.checks.declared import (
-    STUDIES,
-    continuity,
-    decades,
-    duplicated_contact,
-    energy_shares,
-    extremes,
-    grazing,
-    speed_accuracy,
+from lawbench.cases._chains import (
+    NEWTONS_CRADLE,
+    PLASTIC_CHAIN,
+    SPRINGS,
+    masses_extremes,
+    two_contact_studies,
 )
 from lawbench.core.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.core.problem import ImpactProblem
@@ -144,33 +140,8 @@ class ThreeBallChain(Case):
 CASES.register(ThreeBallChain())
 
 
-_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
-for study in (
-    extremes(
-        "three_ball_chain_stiffness",
-        "stiffness ratio (contact 1 over contact 0)",
-        "three_ball_chain",
-        "stiffness_ratio",
-        grid={"stiffness_ratio": decades(-4, 4, 4), **_ELASTIC_AND_PLASTIC},
-        full={"grid": {"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC}},
-    ),
-    extremes(
-        "three_ball_chain_masses",
-        "striker's mass [kg], the others 1 kg",
-        "three_ball_chain",
-        "masses",
-        grid={"masses": [[r, 1.0, 1.0] for r in decades(-6, 6, 3)], **_ELASTIC_AND_PLASTIC},
-        full={"grid": {"masses": [[r, 1.0, 1.0] for r in decades(-6, 6)], **_ELASTIC_AND_PLASTIC}},
-    ),
-    grazing("three_ball_chain", _ELASTIC_AND_PLASTIC["e"]),
-    duplicated_contact("three_ball_chain", _ELASTIC_AND_PLASTIC["e"]),
-    speed_accuracy("three_ball_chain"),
-    energy_shares(
-        "three_ball_chain",
-        decades(-3, 3, 2),
-        np.logspace(-3, 3, 25).tolist(),
-        name="dispersion",
-    ),
-    continuity("three_ball_chain"),
-):
-    STUDIES.register(study)
+# The studies this scene declares, as data.
+ThreeBallChain.studies = (
+    *two_contact_studies("stiffness ratio (contact 1 over contact 0)", name="dispersion"),
+    masses_extremes("striker's mass [kg], the others 1 kg", 2),
+)

@@ -15,17 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases._chains import SPRINGS
-from lawbench.checks.declared import (
-    STUDIES,
-    continuity,
-    decades,
-    duplicated_contact,
-    energy_shares,
-    extremes,
-    grazing,
-    speed_accuracy,
-)
+from lawbench.cases._chains import SPRINGS, two_contact_studies
 from lawbench.core.case import CASES, Case, Params, Reference, exactly, per_item
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags
@@ -163,20 +153,5 @@ class TwoBallsWall(Case):
 CASES.register(TwoBallsWall())
 
 
-_ELASTIC_AND_PLASTIC = {"e": [[0.0], [1.0]]}
-for study in (
-    energy_shares("two_balls_wall", decades(-3, 3, 2), np.logspace(-3, 3, 25).tolist()),
-    continuity("two_balls_wall"),
-    extremes(
-        "two_balls_wall_stiffness",
-        "stiffness ratio (wall over balls)",
-        "two_balls_wall",
-        "stiffness_ratio",
-        grid={"stiffness_ratio": decades(-4, 4, 4), **_ELASTIC_AND_PLASTIC},
-        full={"grid": {"stiffness_ratio": decades(-8, 8), **_ELASTIC_AND_PLASTIC}},
-    ),
-    grazing("two_balls_wall", _ELASTIC_AND_PLASTIC["e"]),
-    duplicated_contact("two_balls_wall", _ELASTIC_AND_PLASTIC["e"]),
-):
-    STUDIES.register(study)
-STUDIES.register(speed_accuracy("two_balls_wall"))
+# The studies this scene declares, as data.
+TwoBallsWall.studies = two_contact_studies("stiffness ratio (wall over balls)")

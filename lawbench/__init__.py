@@ -3,7 +3,7 @@
 The entry points share one convention, ``(law, scene name or problem, **params,
 options=...)``: `solve` returns the `Outcome`, `evaluate` the whole `Trial`, `run_checks` the
 verdict of every check (it also takes a trial alone). Laws, scenes and studies are in the
-read-only registries `LAWS`, `CASES` and ``lawbench.checks.declared.STUDIES``; every check's
+read-only registries `LAWS`, `CASES` and ``lawbench.studies.declared.STUDIES``; every check's
 result carries a `Verdict`. `solve_batch` solves many problems of one shape, `fit` identifies
 a law's coefficients from measured velocities, `check_law` holds any law to the common checks,
 `load_problem` and `save_problem` read and write problem files, `load_run` reads a run table.
@@ -14,9 +14,12 @@ form, ``W``, ``q``, ``mu`` as given), solved by a law's ``solve_contact`` into a
 The package is built in layers, each importing only those below it::
 
     views      command line, report, figures           (lawbench.views)
-    studies    grids, runs, tables, baselines, fits    (lawbench.studies)
-    laws, cases                                          (lawbench.laws, lawbench.cases)
-    checks     checks, measures, regions, studies as data (lawbench.checks)
+    bench, fitting   the benchmark, fits to measurements (lawbench.bench, lawbench.fitting)
+    studies    the study engine: studies built from their declarations, grids, runs,
+               tables, baselines                       (lawbench.studies)
+    laws, cases  laws and scenes, their studies declared as data
+                                                         (lawbench.laws, lawbench.cases)
+    checks     checks, measures, regions               (lawbench.checks)
     numerics, files                                      (lawbench.numerics, lawbench.files)
     core       problem, outcome, law, case, registries, errors, verdicts (lawbench.core)
 

@@ -21,7 +21,11 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 # Where each package's sources are, as it installs (pyproject's package-dir).
 SOURCES = {"lawbench": "lawbench", "lawbench.laws": "laws", "lawbench.cases": "cases"}
-# Lowest first; the packages of one layer are siblings that never import each other.
+# Lowest first; the packages of one layer are siblings that never import each other. The
+# scenes and laws declare their studies as data; the study engine above them builds and runs
+# them; the bench and the fits use the engine; the views show it all. A layer's package not
+# (yet) in the tree is skipped: ``lawbench.bench`` and ``lawbench.fitting`` grow out of
+# ``lawbench.studies.bench`` and ``lawbench.studies.fitting``.
 LAYERS = (
     ("lawbench.core",),
     ("lawbench.numerics", "lawbench.files"),
@@ -197,8 +201,9 @@ def test_at_most_twelve_modules_at_the_top_of_lawbench():
 
 
 def test_every_subpackage_says_what_it_owns_and_may_import():
-    for package in (p for layer in LAYERS for p in layer):
-        path = module_files(ROOT)[package]
+    modules = module_files(ROOT)
+    for package in (p for layer in LAYERS for p in layer if p in modules):
+        path = modules[package]
         doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
         assert "import" in doc, f"{package}: its docstring does not say what it may import"
 

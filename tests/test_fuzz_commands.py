@@ -32,7 +32,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import lawbench
-from lawbench.checks.declared import STUDIES
+from lawbench.studies.declared import STUDIES
 from lawbench.views.cli import build_parser, main
 
 LAWS = lawbench.LAWS.names()

@@ -17,9 +17,10 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 import lawbench
-from lawbench.checks.declared import STUDIES
 from lawbench.core.verdicts import Verdict
+from lawbench.studies.declared import STUDIES
 from lawbench.views.report import QUICK, write_report
+from lawbench.views.report.config import view
 from lawbench.views.report.inside import QUANTITIES
 from lawbench.views.report.marks import Mark
 from lawbench.views.report.outcomes import _figure as outcomes_figure
@@ -298,7 +299,7 @@ def _answered(tables: dict[str, pd.DataFrame], names) -> pd.DataFrame:
 
 def test_the_stability_grid_has_no_nan_and_no_time_out(report):
     tables = runs(report)
-    stability = [s.name for s in STUDIES.values() if s.view == "stability"]
+    stability = [s.name for s in STUDIES.values() if view(s) == "stability"]
     cells = pd.concat([tables[n] for n in stability if n in tables], ignore_index=True)
     assert set(cells["verdict"]) <= CLASSES
     budget = cells[cells["verdict"] == "budget"]
@@ -511,7 +512,7 @@ def test_the_quick_report_end_to_end(quick):
 @pytest.mark.slow
 def test_the_quick_stability_grid_has_no_nan_and_no_time_out(quick):
     tables = runs(quick[0])
-    stability = [s.name for s in STUDIES.values() if s.view == "stability"]
+    stability = [s.name for s in STUDIES.values() if view(s) == "stability"]
     cells = pd.concat([tables[n] for n in stability if n in tables], ignore_index=True)
     assert set(cells["verdict"]) <= CLASSES
     assert not (cells["error_class"].fillna("") == "WorkerDied").any()

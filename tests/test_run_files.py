@@ -11,9 +11,9 @@ import pandas as pd
 import pytest
 
 import lawbench
-from lawbench.checks.study import Job, Plan
 from lawbench.studies.runfile import Store
 from lawbench.studies.runner import Task, compute, run
+from lawbench.studies.study import Job, Plan
 from lawbench.views.cli import main
 
 GRID = [

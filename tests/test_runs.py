@@ -8,13 +8,13 @@ import pandas as pd
 import pytest
 
 import lawbench
-from lawbench.checks.study import Job, Plan
 from lawbench.core.transforms import apply, parse, spell
 from lawbench.studies.grid import RunSpec, values
 from lawbench.studies.guard import Guard
 from lawbench.studies.record import budget_text
 from lawbench.studies.runfile import untidy
 from lawbench.studies.runner import Executor, Task, compute, run, run_many
+from lawbench.studies.study import Job, Plan
 
 SPEC = {
     "seed": 3,

@@ -15,9 +15,9 @@ import pytest
 
 import lawbench
 from lawbench.cases.rocking_block import housner_ratio
-from lawbench.checks.declared import STUDIES
-from lawbench.checks.study import Study
 from lawbench.core.verdicts import Verdict
+from lawbench.studies.declared import STUDIES
+from lawbench.studies.study import Study
 from lawbench.studies.tables import Table, study_table
 
 
@@ -286,7 +286,7 @@ def test_every_sweep_states_the_unit_of_what_it_draws():
     """Each panel of a sweep holds one quantity with its unit: the study declares a unit for
     every measure it draws, and its abscissa is a scene parameter with a unit."""
     for study in STUDIES.values():
-        if study.view != "sweep":
+        if study.shape != "sweep":
             continue
         drawn = list(study.axes[1:]) or list(study.measures)
         assert set(drawn) <= set(study.units), study.name

@@ -1,10 +1,11 @@
-"""What is asked of a law's answer: checks with their verdicts, measures, regions and studies.
+"""What is asked of a law's answer: checks with their verdicts, measures and regions.
 
 Owns the checks (each returns a value, a verdict and a reason, or is skipped with one), the
-regions where a law's claims apply, the measures a study records, rigid laws met event by event
-through gaps, and studies as data (`Study`, the `STUDIES` registry and the shapes that laws and
-scenes declare theirs with). May import `lawbench.core` and `lawbench.numerics`, never a law,
-a scene, the study engine or a view.
+regions where a law's claims apply, the measures a study records and the values its sweeps give
+(`lawbench.checks.knobs`), and rigid laws met event by event through gaps. Laws and scenes
+import it to state their claims and the measures of the studies they declare as data; the study
+engine that builds and runs those studies is above them (`lawbench.studies`). May import
+`lawbench.core` and `lawbench.numerics`, never a law, a scene, the study engine or a view.
 
 Single-solve checks read one trial (a law solved on a case): ``energy_gain``, ``energy_kept``,
 ``admissible``, ``impulse_sign``, ``friction_cone``, ``momentum``, ``reference``; `run_checks`

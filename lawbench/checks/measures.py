@@ -7,7 +7,7 @@
   a stated model),
   ``max |v+ - v_truth| / max |v-|``;
 - `numerical_error`: the distance from the law's own answer at its tightest accuracy knob
-  (`lawbench.checks.study.tightest`), the same way; 0 for an exact law, None for a knob that chooses
+  (`lawbench.checks.knobs.tightest`), the same way; 0 for an exact law, None for a knob that chooses
   between models (an ordering) rather than an accuracy.
 
 Both solve again in the worker; each answer is kept per process, so a sweep pays for the
@@ -23,7 +23,7 @@ import numpy as np
 
 from lawbench.checks.continuity import jumps
 from lawbench.checks.dispersion import dispersion_index as _index
-from lawbench.checks.study import tightest
+from lawbench.checks.knobs import tightest
 from lawbench.core.arrays import is_sparse
 from lawbench.core.errors import LawbenchError
 from lawbench.core.law import LAWS

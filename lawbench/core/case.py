@@ -110,6 +110,8 @@ class Case(ABC):
     summary: ClassVar[str]
     params: ClassVar[tuple[Spec, ...]]
     requires: ClassVar[Tags] = Tags()
+    # Studies the scene declares, as data (`lawbench.studies.declared` builds them when asked).
+    studies: ClassVar[tuple[dict[str, Any], ...]] = ()
     # What the scene's outcomes are measured against (model error), and why.
     ground_truth: ClassVar[GroundTruth | None] = None
     references: ClassVar[tuple[Reference, ...]] = ()

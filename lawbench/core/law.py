@@ -64,6 +64,8 @@ class Law(ABC):
     source: ClassVar[str]
     tags: ClassVar[Tags]
     options: ClassVar[tuple[Spec, ...]] = ()
+    # Studies the law declares, as data (`lawbench.studies.declared` builds them when asked).
+    studies: ClassVar[tuple[dict[str, Any], ...]] = ()
     # Whether the law follows contacts through their gaps (resolves time): then it receives the
     # whole problem; otherwise only the closed contacts, an open one being no part of the impact.
     follows_gaps: ClassVar[bool] = False

@@ -28,7 +28,7 @@ vectors). A generator's bounds are finite, a ``random`` one's ``low <= high`` (b
 at most `MAX_CELLS` rows. Rows are the Cartesian product in the order written: cases, then laws,
 then parameters, then options, then transforms. A malformed generator raises `InvalidProblem` as
 the grid is read; every row is checked before any work: an unknown name or a value out of range
-raises `InvalidProblem`. A row is a `lawbench.checks.study.Job`; `RunSpec.plan` gives the
+raises `InvalidProblem`. A row is a `lawbench.studies.study.Job`; `RunSpec.plan` gives the
 executor's plan (`lawbench.studies.runner.run`). `RunSpec.count` counts the rows from the grid's
 sizes and `RunSpec.sample` builds a few of them alone, so a grid of millions of rows is sized and
 timed before it is built.
@@ -49,12 +49,12 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 
 from lawbench.checks import CHECKS, SINGLE_SOLVE
-from lawbench.checks.study import Job, Plan
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
 from lawbench.core.transforms import parse
 from lawbench.files.paths import input_file
+from lawbench.studies.study import Job, Plan
 
 if TYPE_CHECKING:
     from lawbench.core.case import Case

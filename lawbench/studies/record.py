@@ -21,11 +21,11 @@ from typing import Any
 import numpy as np
 
 from lawbench.checks import CheckResult
-from lawbench.checks.study import Job
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.trial import Trial
 from lawbench.core.verdicts import Verdict, of_error
 from lawbench.studies.guard import WALL_CLOCK
+from lawbench.studies.study import Job
 
 STEP_KEYS = ("steps", "impacts", "iterations")
 # Worst first: a cell's verdict is the worst of its checks' (a check that does not apply to the
@@ -84,7 +84,7 @@ class Record:
     index, key, study : int, str, str
         The cell's place in its run, its stable identity (for resuming) and its study.
     law, case, params, options, transform, repeat
-        The cell (`lawbench.checks.study.Job`); parameters and options as JSON text.
+        The cell (`lawbench.studies.study.Job`); parameters and options as JSON text.
     verdict : str
         The worst verdict of its checks, or that of the error that stopped it.
     status, error_class, error_message : str

@@ -1,6 +1,6 @@
 """The executor: every study cell and every ``lawbench run`` row, one record each, one guard.
 
-`compute` solves one cell (`lawbench.checks.study.Job`), runs its checks and measures, and returns
+`compute` solves one cell (`lawbench.studies.study.Job`), runs its checks and measures, and returns
 its `lawbench.studies.record.Record` row; it never raises: a failure is recorded with its error
 class and message and the run goes on (nevergrad's runner does the same). An `Executor` runs cells
 in this process (``serial``), in local worker processes (``processes``) or on a Dask cluster
@@ -32,7 +32,6 @@ import pandas as pd
 from tqdm import tqdm
 
 from lawbench.checks import run_checks
-from lawbench.checks.study import Job, Measure, Plan
 from lawbench.core.errors import InvalidProblem
 from lawbench.files.paths import output_file
 from lawbench.studies.guard import (
@@ -47,6 +46,7 @@ from lawbench.studies.guard import (
 )
 from lawbench.studies.record import Record
 from lawbench.studies.runfile import Store, file_format, metadata
+from lawbench.studies.study import Job, Measure, Plan
 
 
 class WorkerDied(Exception):
@@ -314,35 +314,10 @@ def run_many(
         for store, (grid, described) in zip(stores, grids, strict=True):
             locks.enter_context(store.locked(wait))
             store.claim(grid, described)
-        tasks, owner = [], []
-        for number, ((plan, out), store) in enumerate(zip(plans, stores, strict=True)):
-            finished = store.done()
-            if len(finished) and not resume:
-                raise InvalidProblem(f"{out} already holds results: give --resume or another --out")
-            done = set(finished["key"]) if len(finished) else set()
-            for index, job in enumerate(plan.jobs):
-                if job.key not in done:
-                    task = Task(index, job, plan.name, plan.checks, plan.settings, plan.measures)
-                    tasks.append(task)
-                    owner.append(number)
+        tasks, owner = _pending(plans, stores, resume)
         total = sum(len(plan.jobs) for plan, _ in plans)
-        buffers: list[list[dict]] = [[] for _ in plans]
         with _progress(total, total - len(tasks), quiet) as progress:
-            failed = 0
-            try:
-                for position, row in executor.run(tasks):
-                    buffer = buffers[owner[position]]
-                    buffer.append(row)
-                    failed += row["error_class"] != ""
-                    progress.set_postfix(failed=failed, refresh=False)
-                    progress.update()
-                    if len(buffer) >= chunk_size:
-                        stores[owner[position]].write_chunk(buffer)
-                        buffer.clear()
-            finally:
-                for store, buffer in zip(stores, buffers, strict=True):
-                    if buffer:
-                        store.write_chunk(buffer)
+            _write(executor.run(tasks), owner, stores, chunk_size, progress)
         computed = [owner.count(number) for number in range(len(plans))]
         meta = metadata(seed)
         return [
@@ -354,6 +329,59 @@ def run_many(
                 stores, plans, computed, grids, strict=True
             )
         ]
+
+
+def _pending(
+    plans: Sequence[tuple[Plan, Path]], stores: Sequence[Store], resume: bool
+) -> tuple[list[Task], list[int]]:
+    """The cells of ``plans`` not yet in their stores, and the number of the plan of each.
+
+    Raises
+    ------
+    InvalidProblem
+        For a store that holds results without ``resume``.
+    """
+    tasks, owner = [], []
+    for number, ((plan, out), store) in enumerate(zip(plans, stores, strict=True)):
+        finished = store.done()
+        if len(finished) and not resume:
+            raise InvalidProblem(f"{out} already holds results: give --resume or another --out")
+        done = set(finished["key"]) if len(finished) else set()
+        for index, job in enumerate(plan.jobs):
+            if job.key not in done:
+                tasks.append(Task(index, job, plan.name, plan.checks, plan.settings, plan.measures))
+                owner.append(number)
+    return tasks, owner
+
+
+def _write(
+    rows: Iterator[tuple[int, dict[str, Any]]],
+    owner: Sequence[int],
+    stores: Sequence[Store],
+    chunk_size: int,
+    progress: tqdm,
+) -> None:
+    """Each row as it comes into the store of its plan, ``chunk_size`` rows a chunk file.
+
+    The rows buffered when the run stops, finished or interrupted, are written too: a finished
+    row is never lost.
+    """
+    buffers: list[list[dict]] = [[] for _ in stores]
+    failed = 0
+    try:
+        for position, row in rows:
+            buffer = buffers[owner[position]]
+            buffer.append(row)
+            failed += row["error_class"] != ""
+            progress.set_postfix(failed=failed, refresh=False)
+            progress.update()
+            if len(buffer) >= chunk_size:
+                stores[owner[position]].write_chunk(buffer)
+                buffer.clear()
+    finally:
+        for store, buffer in zip(stores, buffers, strict=True):
+            if buffer:
+                store.write_chunk(buffer)
 
 
 def _fingerprint(plan: Plan) -> tuple[str, str]:

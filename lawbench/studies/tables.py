@@ -17,13 +17,13 @@ from typing import Any
 
 import pandas as pd
 
-from lawbench.checks.declared import STUDIES
-from lawbench.checks.study import Study
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.transforms import parse
+from lawbench.studies.declared import STUDIES
 from lawbench.studies.guard import BUDGET_S
 from lawbench.studies.record import budget_text
 from lawbench.studies.runner import Executor, collect
+from lawbench.studies.study import Study
 
 
 @dataclass

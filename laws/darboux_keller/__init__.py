@@ -60,7 +60,6 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.checks.declared import STUDIES, impact_path
 from lawbench.checks.regions import option
 from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
@@ -186,8 +185,11 @@ def _path(problem: ImpactProblem, record: ImpactRecord) -> dict[str, np.ndarray]
 
 LAWS.register(DarbouxKeller())
 
-# The study this law declares: its stick and slip phases, in "inside an impact".
-
-STUDIES.register(
-    impact_path("darboux_keller", "lamina", "stick and slip phases along the normal impulse")
+# The study this law declares, as data: its stick and slip phases along one impact.
+DarbouxKeller.studies = (
+    {
+        "shape": "impact_path",
+        "case": "lamina",
+        "title": "stick and slip phases along the normal impulse",
+    },
 )

@@ -63,7 +63,6 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.checks.declared import STUDIES, impact_path
 from lawbench.checks.regions import nonlinear_springs
 from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import is_diagonal
@@ -241,8 +240,12 @@ def _path(impact: SpringImpact) -> dict[str, np.ndarray]:
 
 LAWS.register(Jia())
 
-# The study this law declares: its impulse curve, in the report's "inside an impact".
-
-STUDIES.register(
-    impact_path("jia", "ball_chain", "Jia's impulse curve for two colliding balls", {"n": 2})
+# The study this law declares, as data: its impulse curve along one impact.
+Jia.studies = (
+    {
+        "shape": "impact_path",
+        "case": "ball_chain",
+        "title": "Jia's impulse curve for two colliding balls",
+        "params": {"n": 2},
+    },
 )

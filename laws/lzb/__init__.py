@@ -112,7 +112,6 @@ from typing import Any
 import numpy as np
 import scipy.special
 
-from lawbench.checks.declared import STUDIES, impact_path
 from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import is_diagonal
 from lawbench.core.outcome import Outcome
@@ -325,8 +324,11 @@ def _path(impact: EnergeticImpact, problem: ImpactProblem) -> dict[str, np.ndarr
     }
 
 
-# The study this law declares: the energy its contacts exchange, in "inside an impact".
-
-STUDIES.register(
-    impact_path("lzb", "bead_column", "energy exchanged between the contacts of the bead column")
+# The study this law declares, as data: the energy its contacts exchange along one impact.
+LiuZhaoBrogliato.studies = (
+    {
+        "shape": "impact_path",
+        "case": "bead_column",
+        "title": "energy exchanged between the contacts of the bead column",
+    },
 )

@@ -8,7 +8,6 @@ import sys
 from collections.abc import Sequence
 
 from lawbench.checks import run_checks
-from lawbench.checks.study import Job
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
@@ -16,6 +15,7 @@ from lawbench.core.transforms import apply
 from lawbench.core.trial import evaluate
 from lawbench.files.facts import ProblemFile
 from lawbench.studies.guard import alarm
+from lawbench.studies.study import Job
 from lawbench.views.cli.common import _assignments, _path, _seconds, add_assignments
 from lawbench.views.serialize import contact_record, trial_record
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from lawbench.checks.declared import STUDIES
 from lawbench.core.errors import InvalidProblem
 from lawbench.files.paths import output_file
+from lawbench.studies.declared import STUDIES
 from lawbench.views.cli.common import _assignments, _executor_arguments, _path, add_assignments
 
 

@@ -1,6 +1,6 @@
 """The comparison report: every law on every scene, side by side, in seven sections.
 
-`write_report` runs every registered study a section draws (`lawbench.checks.study.Study.view`) and
+`write_report` runs every registered study a section draws (`lawbench.views.report.config.view`) and
 writes a self-contained folder: ``index.html`` and ``report.md`` with the same content, every
 figure as PNG and SVG with the CSV of its data, every table as CSV, every study's table in
 ``runs/``. Sections, each a view of study tables: summary matrix of the checks with the

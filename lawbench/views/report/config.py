@@ -1,7 +1,8 @@
 """What a report runs: the mode, the workers, the guard, and what to restrict it to.
 
-The report knows no scene or law by name: it runs every registered study that a section draws
-(``Study.view``), sized for the mode: ``quick`` (the default: each study as declared, slow ones
+The report knows no scene or law by name: it runs every registered study that a section draws,
+the section chosen here from what the study is (its shape, `Study.shape`: `VIEWS`), sized for
+the mode: ``quick`` (the default: each study as declared, slow ones
 left out, a few minutes on two cores) or ``full`` (each study's ``full`` sizes, slow ones in,
 resumable from ``OUT/runs``, on local processes or a Dask cluster). A test may shrink a preset
 with `dataclasses.replace`.
@@ -11,10 +12,33 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from lawbench.core.errors import InvalidProblem
 
+if TYPE_CHECKING:
+    from lawbench.studies.study import Study
+
 MODES = ("quick", "full")
+# Which view of a section draws a study, by the study's shape (`lawbench.studies.declared.SHAPES`;
+# the stability grid's grazing, duplicated-contact and friction axes are ``extremes``).
+VIEWS = {
+    "summary": "summary",
+    "speed_accuracy": "tradeoff",
+    "extremes": "stability",
+    "energy_map": "paradoxes",
+    "energy_shares": "dispersion",
+    "continuity": "continuity",
+    "impact_path": "inside",
+    "impact_paths": "inside",
+    "sweep": "sweep",
+    "table_path": "table_path",
+}
+
+
+def view(study: Study) -> str | None:
+    """The view that draws ``study`` (a name a section asks `Context.tables` for); None for none."""
+    return VIEWS.get(study.shape or "")
 
 
 @dataclass(frozen=True)

@@ -1,11 +1,11 @@
 """Section 6, dispersion and continuity.
 
-Energy shares: a view of the studies declared with `lawbench.checks.declared.energy_shares`. Each
+Energy shares: a view of the studies declared with `lawbench.studies.declared.energy_shares`. Each
 scene sweeps the stiffness ratio of its contacts; the share of the post-impact kinetic energy
 each body carries and the dispersion index are drawn for every law, and each cell's verdict is
 that of the dispersion check (the shares against the scene's ground truth) and the energy check.
 
-Continuity: a view of the studies declared with `lawbench.checks.declared.continuity`: the outcome
+Continuity: a view of the studies declared with `lawbench.studies.declared.continuity`: the outcome
 jump of every law under vanishing gap and velocity perturbations against the perturbation size,
 and the verdict of the continuity check at the smallest size, whose detail gives the kinetic
 angles between the contacts (Paoli's condition).
@@ -20,9 +20,9 @@ import numpy as np
 import pandas as pd
 
 from lawbench.checks.continuity import CONTINUOUS
-from lawbench.checks.study import Study
 from lawbench.core.case import Case
 from lawbench.core.verdicts import Verdict
+from lawbench.studies.study import Study
 from lawbench.views.report import plots
 from lawbench.views.report.marks import Mark
 from lawbench.views.report.page import Figure, Legend, Section, Table

@@ -1,6 +1,6 @@
 """Section 7, inside an impact: impulses, velocities and energies along the impact.
 
-A view of the studies the laws declare with `lawbench.checks.declared.impact_path`: the laws that
+A view of the studies the laws declare with `lawbench.studies.declared.impact_path`: the laws that
 resolve the impact along an impact variable return, with the option ``path``, what happens on the
 way (`lawbench.core.outcome.Outcome.path`). Each quantity is drawn against the path's first entry
 (the impact variable: time, normal impulse, or Jia's parameter), one panel per quantity and unit,
@@ -8,7 +8,7 @@ one line per component, labelled with its name and unit; phases a law reports at
 (stick, slip, end of compression) are marked when the impact variable is the normal impulse.
 
 A study that names path quantities after its grid parameter in ``axes``
-(`lawbench.checks.declared.impact_paths`) is drawn as one figure: one panel per value of the
+(`lawbench.studies.declared.impact_paths`) is drawn as one figure: one panel per value of the
 parameter and per quantity named, each quantity's components (one per contact) against the
 impact variable, panels of one quantity on a shared vertical axis.
 """
@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from lawbench.checks.study import Study
 from lawbench.core.case import Case
+from lawbench.studies.study import Study
 from lawbench.views.report import plots
 from lawbench.views.report.page import Figure, Section
 from lawbench.views.report.runs import Context, axis_value, parsed

@@ -1,6 +1,6 @@
 """Section 5, energy-increase paradoxes: maps of the energy change of the frictional laws.
 
-A view of the studies declared with `lawbench.checks.declared.energy_map`: each frictional scene
+A view of the studies declared with `lawbench.studies.declared.energy_map`: each frictional scene
 names the two parameters its map spans (and the example it starts from). Every law that can
 treat the scene is solved on the grid; its relative energy change ``dT / T-`` is mapped, and
 beside it the verdict of each cell (the energy-gain check: a gain the law's findings predict is
@@ -17,9 +17,9 @@ import pandas as pd
 from matplotlib.colors import ListedColormap, TwoSlopeNorm
 
 from lawbench.checks.base import TOLERANCE
-from lawbench.checks.study import Study
 from lawbench.core.case import Case
 from lawbench.core.verdicts import Verdict
+from lawbench.studies.study import Study
 from lawbench.views.report import plots
 from lawbench.views.report.marks import COLOURS
 from lawbench.views.report.page import Figure, Legend, Section, Table

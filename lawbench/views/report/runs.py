@@ -17,14 +17,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from lawbench.checks.declared import STUDIES
-from lawbench.checks.study import Study
 from lawbench.core.case import CASES, Case
 from lawbench.core.law import LAWS, Law
 from lawbench.core.registry import Registry
 from lawbench.core.transforms import parse
+from lawbench.studies.declared import STUDIES
 from lawbench.studies.runner import Executor, run_many
-from lawbench.views.report.config import Config
+from lawbench.studies.study import Study
+from lawbench.views.report.config import Config, view
 
 
 def registered(registry: Registry, wanted: Sequence[str] | None) -> tuple[list[Any], list[str]]:
@@ -116,7 +116,7 @@ class Context:
         cases = [case.name for case in self.cases]
         plans = []
         for study in STUDIES.values():
-            if study.view not in views:
+            if view(study) not in views:
                 self.left_out[study.name] = f"no section draws it (`lawbench study {study.name}`)"
                 continue
             if study.slow and not full:
@@ -144,9 +144,9 @@ class Context:
         for study, (table, _) in zip(self.studies, results, strict=True):
             self._tables[study.name] = table
 
-    def tables(self, view: str) -> list[tuple[Study, pd.DataFrame]]:
-        """The studies of ``view`` that ran, with their tables."""
-        return [(s, self._tables[s.name]) for s in self.studies if s.view == view]
+    def tables(self, name: str) -> list[tuple[Study, pd.DataFrame]]:
+        """The studies the view called ``name`` draws that ran, with their tables."""
+        return [(s, self._tables[s.name]) for s in self.studies if view(s) == name]
 
     def every_table(self) -> list[tuple[Study, pd.DataFrame]]:
         """Every study that ran, with its table."""

@@ -1,6 +1,6 @@
 """Section 4, stability at the extremes: a grid of verdicts per law.
 
-A view of the studies declared with `lawbench.checks.declared.extremes`: each scene names the axes
+A view of the studies declared with `lawbench.studies.declared.extremes`: each scene names the axes
 it is pushed along (stiffness and mass ratios over many decades, grazing approach speeds, long
 chains, large friction, a contact given twice), crossed with the values of its other swept
 parameters. Every cell's verdict is the worst of its checks' (`lawbench.checks`), or that of the
@@ -20,8 +20,8 @@ import pandas as pd
 from matplotlib.colors import to_rgb
 from matplotlib.patches import Patch
 
-from lawbench.checks.study import Study
 from lawbench.core.verdicts import Verdict
+from lawbench.studies.study import Study
 from lawbench.views.report import plots
 from lawbench.views.report.marks import COLOURS, Mark
 from lawbench.views.report.page import Figure, Legend, Section, Table

@@ -1,13 +1,13 @@
 """Section 8, sweeps of the sources' systems: what each law gives as one parameter varies.
 
-A view of the studies declared with ``view="sweep"``: the study's first axis (a grid parameter)
+A view of the studies declared with the shape ``sweep``: the study's first axis (a grid parameter)
 is the abscissa, and each of the measures its other axes name (every measure when it names
 none) is drawn against it, one line per law and value of the other grid parameters, one panel per
 measure (a vector measure gives one panel per component); the table lists every cell with its
 verdict. An abscissa over two decades or more (a stiffness ratio) is drawn on a log scale.
 The abscissa takes the unit of the scene's parameter, each panel the unit the study
 declares for its measure (``Study.units``): one panel holds one quantity, so quantities of
-different units (m/s, rad/s) never share an axis. A study declared with ``view="table_path"``
+different units (m/s, rad/s) never share an axis. A study declared with the shape ``table_path``
 draws each law's path of a ball on the table (its ``table_path`` measure, x and y in m) in one
 panel per value of its parameter.
 """

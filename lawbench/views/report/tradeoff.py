@@ -1,6 +1,6 @@
 """Section 3, speed versus accuracy: two errors against cost, never mixed in one column.
 
-A view of the studies declared with `lawbench.checks.declared.speed_accuracy`: per scene, at its
+A view of the studies declared with `lawbench.studies.declared.speed_accuracy`: per scene, at its
 default parameters, every law that can treat it solved at each value of its accuracy knob
 (``Tags.accuracy_knob``), a few times. Cost is the median of the law's own wall time over the
 repeats. Two measures, drawn on two panels:

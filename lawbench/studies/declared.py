@@ -1,35 +1,42 @@
-"""Studies as declared: the registry `STUDIES`, and the shapes laws and scenes declare theirs with.
+"""Studies as declared: the shapes laws and scenes declare theirs with, and the registry `STUDIES`.
 
-A scene (or law) module calls these to register its studies: which scenes enter the speed and
-accuracy comparison, which extremes its stability grid pushes, which two parameters its
-energy-increase map spans, and so on. Each returns a plain `Study` whose ``view`` names the
-report section that draws it. The engine's own study is ``summary``: every law on every scene
-at its defaults, with every check.
+A scene (or a law) declares its studies as plain data, in its class attribute ``studies``: one
+mapping per study, its ``shape`` (a key of `SHAPES`) and the shape's arguments, such as
+``{"shape": "speed_accuracy"}`` (every law on the scene, its accuracy knob swept),
+``{"shape": "extremes", "name": "stiffness", "title": ..., "axis": ..., "grid": ...}`` (one
+axis of the stability grid), or a study written out field by field, ``{"shape": "sweep",
+"name": ..., "title": ..., "grid": ..., "measures": {"omega_ratio": omega_ratio}}`` whose
+measures are module-level functions of the scene. The scene's name (the law's, in a law's
+declaration) is filled in where a shape needs it: a scene never repeats it. `STUDIES` builds
+every `Study` from its declaration the first time studies are listed, looked up or run, so
+importing a scene or a law, or solving one, builds none. The engine's own study is
+``summary``: every law on every scene at its defaults, with every check.
+
+A study keeps the name of its shape (`Study.shape`): the report's configuration chooses the
+section that draws it from that (`lawbench.views.report.config`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from lawbench.checks import CHECKS, SINGLE_SOLVE, measures
-from lawbench.checks.study import Measure, Study
+from lawbench.checks.knobs import decades
 from lawbench.core.case import CASES
+from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
 from lawbench.core.registry import Registry
+from lawbench.studies.study import Measure, Study
 
 # Accuracy knob values of the speed/accuracy sweep (quick; the full report sweeps every decade).
 KNOBS = (1e-2, 1e-6, 1e-10)
 # Perturbation sizes of the continuity sweep (quick and full).
 JUMP_SIZES = (1e-2, 1e-4, 1e-6)
 FULL_JUMP_SIZES = tuple(10.0**-k for k in range(1, 9))
-
-
-def decades(start: int, stop: int, step: int = 1) -> list[float]:
-    """Powers of ten ``10**start ... 10**stop`` (both included) every ``step`` decades."""
-    return [float(10.0**k) for k in range(start, stop + int(np.sign(step)), step)]
 
 
 def speed_accuracy(case: str, slow: bool = False) -> Study:
@@ -48,16 +55,16 @@ def speed_accuracy(case: str, slow: bool = False) -> Study:
             "model_error": measures.model_error,
             "numerical_error": measures.numerical_error,
         },
-        view="tradeoff",
+        shape="speed_accuracy",
         slow=slow,
         full={"knobs": decades(-1, -11, -1), "repeats": 5},
     )
 
 
 def extremes(
+    case: str,
     name: str,
     title: str,
-    case: str,
     axis: str,
     grid: Mapping[str, Sequence[Any]] | None = None,
     params: Mapping[str, Any] | None = None,
@@ -70,11 +77,12 @@ def extremes(
 ) -> Study:
     """One axis of the stability grid: every law on ``case`` pushed along ``axis``.
 
-    ``axis`` is a grid parameter, a measure, or ``transform``; every single-solve check
-    decides the cells.
+    The study is called after the scene and ``name`` (``three_ball_chain_stiffness``).
+    ``axis`` is a grid parameter, a measure, or ``transform``; every single-solve check decides
+    the cells.
     """
     return Study(
-        name=name,
+        name=f"{case}_{name}",
         title=title,
         cases=(case,),
         laws=laws,
@@ -84,7 +92,7 @@ def extremes(
         transform_values=tuple(values),
         measures=dict(measures or {}),
         axes=(axis,),
-        view="stability",
+        shape="extremes",
         full=dict(full or {}),
         slow=slow,
     )
@@ -102,9 +110,9 @@ def grazing(
     report), the motion the contacts do not see kept (`lawbench.core.transforms.grazing`).
     """
     return extremes(
-        f"{case}_grazing",
-        "grazing speed [m/s]",
         case,
+        "grazing",
+        "grazing speed [m/s]",
         "transform",
         grid={"e": list(e)},
         transform="grazing",
@@ -117,9 +125,9 @@ def grazing(
 def duplicated_contact(case: str, e: Sequence[Any], slow: bool = False) -> Study:
     """Every law on ``case`` with its contact 0 given twice, for each restitution of ``e``."""
     return extremes(
-        f"{case}_duplicated",
-        "contact 0 given twice",
         case,
+        "duplicated",
+        "contact 0 given twice",
         "transform",
         grid={"e": list(e)},
         transform="duplicated",
@@ -131,9 +139,9 @@ def duplicated_contact(case: str, e: Sequence[Any], slow: bool = False) -> Study
 def large_friction(case: str) -> Study:
     """Every law on ``case`` at mu = 0 and mu = 1000, each with e = 0 and e = 1."""
     return extremes(
-        f"{case}_friction",
-        "friction coefficient mu",
         case,
+        "friction",
+        "friction coefficient mu",
         "mu",
         grid={"mu": [0.0, 1e3], "e": [0.0, 1.0]},
     )
@@ -163,7 +171,7 @@ def energy_map(
         params=dict(params or {}),
         checks=("energy_gain",),
         axes=(x[0], y[0]),
-        view="paradoxes",
+        shape="energy_map",
         full={"grid": grid(full_points)},
     )
 
@@ -187,7 +195,7 @@ def energy_shares(
         },
         checks=("energy_gain", "dispersion"),
         axes=("stiffness_ratio",),
-        view="dispersion",
+        shape="energy_shares",
         full={"grid": {"stiffness_ratio": list(full_ratios)}},
     )
 
@@ -205,7 +213,7 @@ def continuity(case: str) -> Study:
         measures={"jumps": measures.continuity_jumps},
         checks=("continuity",),
         settings={"continuity_sizes": list(JUMP_SIZES)},
-        view="continuity",
+        shape="continuity",
         full={"settings": {"continuity_sizes": list(FULL_JUMP_SIZES)}},
     )
 
@@ -220,15 +228,15 @@ def impact_path(law: str, case: str, title: str, params: Mapping[str, Any] | Non
         params=dict(params or {}),
         options={law: {"path": [True]}},
         measures={"path": measures.impact_path},
-        view="inside",
+        shape="impact_path",
     )
 
 
 def impact_paths(
+    case: str,
     name: str,
     title: str,
     laws: tuple[str, ...],
-    case: str,
     axis: str,
     values: Sequence[Any],
     quantities: Sequence[str],
@@ -249,29 +257,22 @@ def impact_paths(
         measures={"path": measures.impact_path, **dict(extra or {})},
         checks=("energy_gain",),
         axes=(axis, *quantities),
-        view="inside",
+        shape="impact_paths",
     )
 
 
-class _Studies(Registry[Study]):
-    """Studies are declared in the law and case modules: loading them loads both packages.
+def custom(shape: str, case: str, name: str, title: str, **fields: Any) -> Study:
+    """A study on ``case`` written out field by field (the other fields of `Study`).
 
-    The engine's own study (``summary``) is declared below.
+    ``shape`` says what it is for the report: ``sweep`` (measures against one grid parameter)
+    or ``table_path`` (a ball's path on the table per value of its parameter).
     """
-
-    def _load(self) -> None:
-        if self._loaded:
-            return
-        LAWS.names()
-        CASES.names()
-        self._loaded = True
+    return Study(name=name, title=title, cases=(case,), shape=shape, **fields)
 
 
-STUDIES: _Studies = _Studies("study", "lawbench.cases", Study)
-
-
-STUDIES.register(
-    Study(
+def summary() -> Study:
+    """The engine's own study: every law on every scene at its defaults, with every check."""
+    return Study(
         name="summary",
         title="every law on every scene at its defaults, with every check",
         laws="every",
@@ -281,7 +282,76 @@ STUDIES.register(
             "model_error": measures.model_error,
             "truth_velocity": measures.truth_velocity,
         },
-        view="summary",
+        shape="summary",
         full={"settings": {"continuity_sizes": [1e-2, 1e-4, 1e-6]}},
     )
-)
+
+
+# What declares studies, as messages call it, by the keyword its name fills in.
+_OWNERS = {"case": "scene", "law": "law"}
+# Shape name -> what builds its study; a scene's declaration gets its name as ``case``, a law's
+# its name as ``law``.
+SHAPES: dict[str, Callable[..., Study]] = {
+    "speed_accuracy": speed_accuracy,
+    "extremes": extremes,
+    "grazing": grazing,
+    "duplicated_contact": duplicated_contact,
+    "large_friction": large_friction,
+    "energy_map": energy_map,
+    "energy_shares": energy_shares,
+    "continuity": continuity,
+    "impact_path": impact_path,
+    "impact_paths": impact_paths,
+    "sweep": partial(custom, "sweep"),
+    "table_path": partial(custom, "table_path"),
+}
+
+
+def build(declaration: Mapping[str, Any], kind: str, owner: str) -> Study:
+    """The study a scene (``kind`` 'case') or a law (``kind`` 'law') called ``owner`` declares.
+
+    Raises
+    ------
+    InvalidProblem
+        For an unknown shape or arguments the shape does not take, naming the scene or law
+        and the study.
+    """
+    arguments = dict(declaration)
+    shape = arguments.pop("shape", None)
+    where = f"{_OWNERS[kind]} {owner}, study {arguments.get('name', shape)!r}"
+    if shape not in SHAPES:
+        raise InvalidProblem(f"{where}: shape {shape!r} is not one of {', '.join(SHAPES)}")
+    try:
+        return SHAPES[shape](**{kind: owner}, **arguments)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{where} ({shape}): {exc}") from None
+
+
+class _Studies(Registry[Study]):
+    """The engine's own study and those the scenes and laws declare, built on first use.
+
+    Listing, looking up or running any study loads every scene and law and builds every
+    study at once: a study's name says nothing of the module that declares it.
+    """
+
+    def _load(self) -> None:
+        if self._loaded:
+            return
+        built = {"summary": summary()}
+        for kind, registry in (("case", CASES), ("law", LAWS)):
+            for owner in registry.values():
+                for declaration in owner.studies:
+                    study = build(declaration, kind, owner.name)
+                    if study.name in built or study.name in self._entries:
+                        raise InvalidProblem(
+                            f"{_OWNERS[kind]} {owner.name}: study {study.name!r} is declared twice"
+                        )
+                    built[study.name] = study
+        self._entries.update(built)
+        self._loaded = True
+
+    def _load_one(self, name: str) -> None:
+        self._load()
+
+
+STUDIES: _Studies = _Studies("study", "lawbench.cases", Study)

@@ -1,29 +1,33 @@
 """Studies as data: a grid of cells, what it measures and which checks decide its verdicts.
 
-A study (laws x scenes x parameters x options x transforms) is declared where its scene or law is
-(in the module of the case or the law) and registered in `STUDIES`; the engine knows none by name.
-Its grid expands deterministically into `Job` cells (one law with options on one scene with
-parameters, optionally a named transform of the built problem, `lawbench.core.transforms`); the
-executor (`lawbench.studies.runner`) runs every cell the same way and returns one tidy table whose
-rows are `lawbench.studies.record.Record` rows: the outcome, the measured columns, and the verdict
-of each named check.
+A study (laws x scenes x parameters x options x transforms) is declared, as plain data, where its
+scene or law is (the class attribute ``studies`` of the case or the law); the registry `STUDIES`
+(`lawbench.studies.declared`) builds each `Study` from its declaration the first time studies
+are listed, looked up or run, and the engine knows none by name. Its grid expands
+deterministically into `Job` cells (one law with options on one scene with parameters,
+optionally a named transform of the built problem, `lawbench.core.transforms`); the executor
+(`lawbench.studies.runner`) runs every cell the same way and returns one tidy table whose rows
+are `lawbench.studies.record.Record` rows: the outcome, the measured columns, and the verdict of
+each named check.
 
-Declaring a study, in a case module::
+Declaring a custom study, in a case module (the scene's own name is filled in)::
 
     def omega_ratio(trial):
         return trial.outcome.v_plus[2] / trial.problem.v[2]
 
-    STUDIES.register(
-        Study(
-            name="rocking_block",
-            title="omega+/omega- over aspect ratios",
-            cases=("rocking_block",),
-            laws="every",
-            grid={"width": np.logspace(-1, 1, 9).tolist(), "mu": [0.0, 1.0]},
-            params={"height": 1.0, "e": 0.0},
-            measures={"omega_ratio": omega_ratio},
+    class RockingBlock(Case):
+        ...
+        studies = (
+            {
+                "shape": "sweep",
+                "name": "rocking_block",
+                "title": "omega+/omega- over aspect ratios",
+                "laws": "every",
+                "grid": {"width": np.logspace(-1, 1, 9).tolist(), "mu": [0.0, 1.0]},
+                "params": {"height": 1.0, "e": 0.0},
+                "measures": {"omega_ratio": omega_ratio},
+            },
         )
-    )
 
 A measure reads the `Trial` and returns a number, a sequence of numbers (a list column), a
 mapping of arrays, or None where it does not apply. Measures travel to worker processes by
@@ -39,6 +43,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from lawbench.checks.knobs import knob_values
 from lawbench.core.errors import InvalidProblem
 
 if TYPE_CHECKING:
@@ -51,10 +56,6 @@ Measure = Callable[[Any], Any]
 # requirements ('covering'), every law that accepts the problem built at the study's fixed
 # parameters ('able'), or every registered law, refusals included ('every').
 LAW_CHOICES = ("covering", "able", "every")
-# Values of an integer accuracy knob in a sweep.
-INT_KNOBS = (10, 100, 1_000, 10_000, 100_000)
-# The tightest value tried for a numeric accuracy knob (or the nearest its spec accepts).
-TIGHTEST = 1e-12
 
 
 def _cli(value: Any) -> str:
@@ -149,44 +150,6 @@ class Plan:
     measures: Mapping[str, Measure] = field(default_factory=dict)
 
 
-def knob_values(law: Law, values: Sequence[float]) -> tuple[str | None, list[Any]]:
-    """A law's accuracy knob and the values a sweep gives it.
-
-    Those of ``values`` its spec accepts, every choice of a choice knob, a few decades of an
-    integer one; ``(None, [None])`` for an exact law.
-    """
-    knob = law.tags.accuracy_knob
-    spec = next((s for s in law.options if s.name == knob), None)
-    if spec is None:
-        return None, [None]
-    if spec.choices:
-        return knob, list(spec.choices)
-    if spec.kind == "bool":
-        return knob, [False, True]
-    candidates = INT_KNOBS if spec.kind == "int" else values
-    return knob, [v for v in candidates if _accepts(spec, v)] or [spec.default]
-
-
-def tightest(law: Law) -> dict[str, Any]:
-    """Options at a law's tightest numeric knob; {} for an exact law or a choice knob."""
-    knob = law.tags.accuracy_knob
-    spec = next((s for s in law.options if s.name == knob), None)
-    if spec is None or spec.choices or spec.kind in ("bool", "str"):
-        return {}
-    if spec.kind == "int":
-        return {knob: max(v for v in (*INT_KNOBS, spec.default) if _accepts(spec, v))}
-    accepted = [TIGHTEST * 10.0**k for k in range(12) if _accepts(spec, TIGHTEST * 10.0**k)]
-    return {knob: accepted[0]} if accepted else {}
-
-
-def _accepts(spec: Any, value: Any) -> bool:
-    try:
-        spec.coerce(value)
-    except InvalidProblem:
-        return False
-    return True
-
-
 @dataclass(frozen=True)
 class Study:
     """A named grid of laws x scenes x parameters x options x transforms, with its columns.
@@ -228,8 +191,10 @@ class Study:
     units : mapping
         Measure (or quantity a view draws) -> its unit ('' for dimensionless); views label
         their axes with it (a grid parameter takes the unit of its scene's `Spec`).
-    view : str or None
-        The report section that shows the study (``lawbench.views.report``), None for none.
+    shape : str or None
+        What kind of study it is: the shape it was declared with
+        (`lawbench.studies.declared.SHAPES`: ``speed_accuracy``, ``extremes``, a custom
+        ``sweep``, ...); the report's configuration chooses the section that draws it from this.
     slow : bool
         Left out of the quick report (a long sweep).
     full : mapping
@@ -252,7 +217,7 @@ class Study:
     repeats: int = 1
     axes: tuple[str, ...] = ()
     units: Mapping[str, str] = field(default_factory=dict)
-    view: str | None = None
+    shape: str | None = None
     slow: bool = False
     full: Mapping[str, Any] = field(default_factory=dict)
 

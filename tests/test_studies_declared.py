@@ -1,0 +1,88 @@
+"""Studies declared as data by the scenes and laws, built by the registry only when asked for."""
+
+import subprocess
+import sys
+
+import pytest
+
+from lawbench.core.case import CASES
+from lawbench.core.errors import InvalidProblem
+from lawbench.studies.declared import SHAPES, STUDIES, _Studies, build
+from lawbench.studies.study import Study
+from lawbench.views.report.config import VIEWS, view
+
+LOAD_EVERY_SCENE_AND_LAW = """
+import sys
+import lawbench.cases
+from lawbench.core.case import CASES
+from lawbench.core.law import LAWS
+cases, laws = list(CASES.values()), list(LAWS.values())
+assert cases and laws
+declared = sum(len(entry.studies) for entry in (*cases, *laws))
+assert declared > 30, declared
+engine = sorted(m for m in sys.modules if m.startswith("lawbench.studies"))
+print(",".join(engine))
+"""
+
+
+def test_loading_every_scene_and_law_builds_no_study_and_imports_no_study_engine():
+    done = subprocess.run(
+        [sys.executable, "-c", LOAD_EVERY_SCENE_AND_LAW],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert done.stdout.strip() == ""
+
+
+def test_every_declaration_becomes_one_study_named_after_its_scene_or_law():
+    declared = sum(len(case.studies) for case in CASES.values())
+    assert len(STUDIES) >= declared + 1  # the engine's own summary, and the laws' studies
+    grazing = STUDIES.get("lamina_grazing")
+    assert isinstance(grazing, Study) and grazing.cases == ("lamina",)
+    assert grazing.shape == "extremes"
+    assert STUDIES.get("jia_path").laws == ("jia",)
+
+
+def test_the_report_draws_every_study_by_its_shape():
+    assert {study.shape for study in STUDIES.values()} <= set(VIEWS)
+    assert all(view(study) is not None for study in STUDIES.values())
+    assert view(STUDIES.get("lamina_speed_accuracy")) == "tradeoff"
+    assert view(STUDIES.get("lamina_friction")) == "stability"
+
+
+@pytest.mark.parametrize(
+    ("declaration", "words"),
+    [
+        ({"shape": "spline", "name": "wiggle"}, ("scene lamina", "'wiggle'", "spline")),
+        ({"shape": "speed_accuracy", "knobs": [1e-3]}, ("scene lamina", "speed_accuracy", "knobs")),
+        ({"shape": "extremes", "name": "tall"}, ("scene lamina", "'tall'", "axis")),
+        ({"title": "no shape"}, ("scene lamina", "None")),
+    ],
+)
+def test_a_bad_declaration_is_an_invalid_problem_naming_its_scene_and_study(declaration, words):
+    with pytest.raises(InvalidProblem) as raised:
+        build(declaration, "case", "lamina")
+    assert all(word in str(raised.value) for word in words), str(raised.value)
+
+
+def test_a_law_declaration_names_the_law():
+    with pytest.raises(InvalidProblem, match="law jia, study 'impact_path'"):
+        build({"shape": "impact_path"}, "law", "jia")
+
+
+def test_a_bad_declaration_stops_the_registry_when_it_is_first_asked(monkeypatch):
+    lamina = type(CASES.get("lamina"))
+    monkeypatch.setattr(lamina, "studies", (*lamina.studies, {"shape": "continuity", "e": 1}))
+    fresh = _Studies("study", "lawbench.cases", Study)
+    with pytest.raises(InvalidProblem, match="scene lamina, study 'continuity'"):
+        fresh.names()
+    monkeypatch.setattr(lamina, "studies", (*lamina.studies[:-1], {"shape": "speed_accuracy"}))
+    fresh = _Studies("study", "lawbench.cases", Study)
+    with pytest.raises(InvalidProblem, match="lamina_speed_accuracy' is declared twice"):
+        fresh.names()
+
+
+def test_every_shape_builds_a_study_the_report_draws():
+    drawn = {"grazing", "duplicated_contact", "large_friction"}  # axes of the stability grid
+    assert set(SHAPES) - drawn <= set(VIEWS)
