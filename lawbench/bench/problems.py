@@ -20,12 +20,13 @@ import numpy as np
 import pandas as pd
 
 from lawbench.bench.peer import siconos_available, siconos_nsgs, siconos_reads_fclib
+from lawbench.core.budget import WALL_CLOCK, alarm
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
-from lawbench.studies.guard import TIME_OUT, WALL_CLOCK, Guard, Result, alarm
+from lawbench.studies.guard import TIME_OUT, Guard, Result
 
 # The extensions of the problem files read (`lawbench.files.problem_files.load_problem`).
 PROBLEM_SUFFIXES = (".json", ".npz", ".h5", ".hdf5")

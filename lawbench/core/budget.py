@@ -13,8 +13,11 @@ from __future__ import annotations
 
 import contextvars
 import math
+import signal
+import threading
 import time
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from typing import Any
 
 from lawbench.core.errors import BudgetExceeded
@@ -122,3 +125,36 @@ _OPEN: contextvars.ContextVar[Budget | None] = contextvars.ContextVar("budget", 
 def current() -> Budget:
     """The budget of the solve under way; an unbounded one outside any solve."""
     return _OPEN.get() or Budget("lawbench")
+
+
+# The budget that a stop from outside the solve names.
+WALL_CLOCK = "wall-clock guard"
+
+
+def stopped(seconds: float) -> BudgetExceeded:
+    """The error of a job stopped by the guard after ``seconds``."""
+    return BudgetExceeded(
+        f"no answer within {seconds:g} s: stopped by the {WALL_CLOCK}", WALL_CLOCK, seconds, seconds
+    )
+
+
+@contextmanager
+def alarm(seconds: float | None) -> Iterator[None]:
+    """Raise `stopped` inside the enclosed code once ``seconds`` have passed.
+
+    No guard when ``seconds`` is None or outside the main thread (signals reach only it).
+    """
+    if not seconds or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def ring(signum: int, frame: Any) -> None:
+        raise stopped(seconds)
+
+    previous = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)

@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
+from lawbench.core.budget import alarm
 from lawbench.core.case import CASES, Case
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem
@@ -31,7 +32,7 @@ class Carried(Protocol):
     """A problem with what was learned while obtaining it (a file as read, a measurement)."""
 
     problem: ImpactProblem | ContactProblem
-    facts: Mapping[str, Any]
+    facts: Any
 
 
 Source = str | Case | ImpactProblem | ContactProblem | Carried
@@ -54,8 +55,8 @@ class Trial:
     outcome: Outcome | ContactSolution | OutcomeBatch
     # Settings of the checks that solve again (for example continuity's perturbation sizes).
     settings: dict[str, Any] = field(default_factory=dict)
-    # What was learned while obtaining the problem (a file's form, storage, rank).
-    facts: Mapping[str, Any] = field(default_factory=dict)
+    # What was learned while obtaining the problem (a file's form and storage), or None.
+    facts: Any = None
 
     @property
     def scene(self) -> str:
@@ -138,6 +139,7 @@ def make_trial(
     options: Mapping[str, Any] | None = None,
     transform: str = "",
     settings: Mapping[str, Any] | None = None,
+    max_seconds: float | None = None,
 ) -> Trial:
     """Solve ``source`` with ``law``: the one way into every solve.
 
@@ -156,6 +158,9 @@ def make_trial(
         A named transform of the built impact problem (``grazing=1e-08``), '' for none.
     settings : mapping, optional
         Settings of the checks that solve again, carried by the trial.
+    max_seconds : float, optional
+        A wall-clock bound on the whole call, kept from outside the law's own budget
+        (`lawbench.core.budget.alarm`): it stops a law that ignores its ``max_seconds``.
 
     Returns
     -------
@@ -169,10 +174,22 @@ def make_trial(
     NotApplicable, SolverFailure
         As the law's solve raises them.
     """
-    law = _law(law)
-    options, facts, scene, full = dict(options or {}), {}, None, {}
+    with alarm(max_seconds):
+        return _trial(_law(law), source, params, dict(options or {}), transform, settings)
+
+
+def _trial(
+    law: Law,
+    source: Source | ProblemBatch,
+    params: Mapping[str, Any] | None,
+    options: dict[str, Any],
+    transform: str,
+    settings: Mapping[str, Any] | None,
+) -> Trial:
+    """`make_trial`'s steps: check and build once, transform, solve."""
+    facts, scene, full = None, None, {}
     if hasattr(source, "facts"):
-        source, facts = source.problem, dict(source.facts)
+        source, facts = source.problem, source.facts
     if isinstance(source, str | Case):
         scene = CASES.get(source)
         full = scene.parameters(**(params or {}))

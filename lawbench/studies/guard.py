@@ -9,9 +9,9 @@ Two forms, one rule: a job that has not answered after its budget is stopped and
   caller even inside compiled code; a worker that dies is replaced the same way, and a worker
   ends with the process that started it (no orphan keeps computing). Warnings a task raises
   are recorded with its result instead of being printed.
-- `alarm` guards a job in this process (the serial executor, ``lawbench solve
-  --max-seconds``): a timer signal raises the `BudgetExceeded` inside the job. It interrupts
-  Python code only, and only in the main thread.
+- `lawbench.core.budget.alarm` guards a job in this process (the serial executor, ``lawbench
+  solve --max-seconds``): a timer signal raises the `BudgetExceeded` inside the job. It
+  interrupts Python code only, and only in the main thread.
 """
 
 from __future__ import annotations
@@ -27,49 +27,16 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from lawbench.core.errors import BudgetExceeded
-
 if TYPE_CHECKING:
     import multiprocessing.process
     from multiprocessing.connection import Connection
 
 TIME_OUT = "time-out"
 WARNINGS_KEPT = 10
-# The budget a guard kill names.
-WALL_CLOCK = "wall-clock guard"
 # Seconds a cell may run before the guard stops it, unless told otherwise.
 BUDGET_S = 600.0
 # Where guarded cells run (`lawbench.studies.runner.Executor`): this process, local workers, Dask.
 EXECUTORS = ("serial", "processes", "dask")
-
-
-def stopped(seconds: float) -> BudgetExceeded:
-    """The error of a job stopped by the guard after ``seconds``."""
-    return BudgetExceeded(
-        f"no answer within {seconds:g} s: stopped by the {WALL_CLOCK}", WALL_CLOCK, seconds, seconds
-    )
-
-
-@contextmanager
-def alarm(seconds: float | None) -> Iterator[None]:
-    """Raise `stopped` inside the enclosed code once ``seconds`` have passed.
-
-    No guard when ``seconds`` is None or outside the main thread (signals reach only it).
-    """
-    if not seconds or threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def ring(signum: int, frame: Any) -> None:
-        raise stopped(seconds)
-
-    previous = signal.signal(signal.SIGALRM, ring)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 @dataclass(frozen=True)

@@ -21,10 +21,10 @@ from typing import Any
 import numpy as np
 
 from lawbench.checks import CheckResult
+from lawbench.core.budget import WALL_CLOCK
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.trial import Trial
 from lawbench.core.verdicts import Verdict, of_error
-from lawbench.studies.guard import WALL_CLOCK
 from lawbench.studies.study import Job
 
 STEP_KEYS = ("steps", "impacts", "iterations")

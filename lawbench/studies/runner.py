@@ -32,6 +32,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from lawbench.checks import run_checks
+from lawbench.core.budget import alarm, stopped
 from lawbench.core.errors import InvalidProblem
 from lawbench.files.paths import output_file
 from lawbench.studies.guard import (
@@ -41,8 +42,6 @@ from lawbench.studies.guard import (
     WARNINGS_KEPT,
     Guard,
     Result,
-    alarm,
-    stopped,
 )
 from lawbench.studies.record import Record
 from lawbench.studies.runfile import Store, file_format, metadata
@@ -68,7 +67,7 @@ class Task:
 def compute(task: Task, alarm_s: float | None = None) -> dict[str, Any]:
     """The record row of one cell: outcome, checks, measures, cost, or the error that stopped it.
 
-    ``alarm_s`` guards the cell in this process (`lawbench.studies.guard.alarm`).
+    ``alarm_s`` guards the cell in this process (`lawbench.core.budget.alarm`).
     """
     start = time.perf_counter()
     heard: list[str] = []

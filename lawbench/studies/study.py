@@ -113,19 +113,16 @@ class Job:
         InvalidProblem, NotApplicable, SolverFailure
             As `lawbench.evaluate` does; a bad transform is an `InvalidProblem`.
         """
-        from lawbench.core.case import CASES
-        from lawbench.core.law import LAWS
-        from lawbench.core.transforms import apply
-        from lawbench.core.trial import Trial
+        from lawbench.core.trial import make_trial
 
-        law, case = LAWS.get(self.law), CASES.get(self.case)
-        params = case.parameters(**self.params)
-        problem = apply(self.transform, case.build(**params))
-        outcome = law.resolve(problem, **dict(self.options))
-        options = outcome.diagnostics["options"]
-        if self.transform:
-            case, params = None, {}
-        return Trial(law, case, params, options, problem, outcome, dict(settings or {}))
+        return make_trial(
+            self.law,
+            self.case,
+            params=self.params,
+            options=self.options,
+            transform=self.transform,
+            settings=settings,
+        )
 
     def command(self, max_seconds: float | None = None) -> str:
         """The ``lawbench solve`` command that solves this cell again, exactly."""

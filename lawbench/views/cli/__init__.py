@@ -30,12 +30,17 @@ from lawbench.views.cli import (
 )
 from lawbench.views.cli.common import EXIT_CODES, _Parser, _Version
 
-# The subcommands in the order ``lawbench --help`` lists them; each adds its own parser.
+# The subcommands in the order ``lawbench --help`` lists them. Each module holds its command's
+# ``COMMAND`` (its name and parser settings), ``arguments`` and ``run``.
 COMMANDS = (listing, describe, solve, export, report, study, run, regress, check, fit, bench)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``lawbench`` command."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the ``lawbench`` command.
+
+    Every subcommand is listed; only ``command`` is given its arguments (every one when None),
+    so that a command's run reads no other command's module.
+    """
     parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
     parser.add_argument("--version", action=_Version, help="print the version and exit")
     parser.add_argument(
@@ -45,9 +50,17 @@ def build_parser() -> argparse.ArgumentParser:
         "diagnostics)",
     )
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for command in COMMANDS:
-        command.add(commands)
+    for module in COMMANDS:
+        name, settings = module.COMMAND
+        subparser = commands.add_parser(name, **settings)
+        if command is None or command in (name, *settings.get("aliases", ())):
+            module.arguments(subparser)
     return parser
+
+
+def _command(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` names: its first word that is not an option, if any."""
+    return next((word for word in argv if not word.startswith("-")), None)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -55,7 +68,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     # The run machinery reports damaged chunks through logging: one line on stderr each.
     logging.basicConfig(format="lawbench: %(message)s", level=logging.WARNING)
     try:
-        args = build_parser().parse_args(argv)
+        argv = sys.argv[1:] if argv is None else list(argv)
+        args = build_parser(_command(argv)).parse_args(argv)
     except SystemExit as exit_:  # usage errors and --help
         return int(exit_.code or 0)
     try:

@@ -13,11 +13,12 @@ from lawbench.views.cli.common import _names, _path, _seconds, _tolerance
 PROBLEM_BUDGET_S = 60.0
 
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``bench`` command."""
-    bench = commands.add_parser(
-        "bench", help="time the laws against clarabel and numpy called directly (ratios)"
-    )
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = ("bench", {"help": "time the laws against clarabel and numpy called directly (ratios)"})
+
+
+def arguments(bench: argparse.ArgumentParser) -> None:
+    """The arguments of the ``bench`` command."""
     bench.add_argument("--quick", action="store_true", help="fewer repetitions, smaller sizes")
     bench.add_argument(
         "--problems",

@@ -10,12 +10,15 @@ from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS, Law
 from lawbench.views.cli.common import MAX_REPEATS, CheckFailed, _count, _names
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = (
+    "check",
+    {"help": "hold a law to the common checks (exit 6 when a cell is not acceptable)"},
+)
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``check`` command."""
-    check = commands.add_parser(
-        "check", help="hold a law to the common checks (exit 6 when a cell is not acceptable)"
-    )
+
+def arguments(check: argparse.ArgumentParser) -> None:
+    """The arguments of the ``check`` command."""
     check.add_argument("law", help="a law name, or module:attribute of a law not registered")
     check.add_argument("--cases", help="comma-separated scenes (default: every one it treats)")
     check.add_argument(

@@ -8,10 +8,12 @@ from lawbench.core.case import CASES, Case
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS, Law
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = ("describe", {"help": "describe a law or a case"})
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``describe`` command."""
-    describe = commands.add_parser("describe", help="describe a law or a case")
+
+def arguments(describe: argparse.ArgumentParser) -> None:
+    """The arguments of the ``describe`` command."""
     describe.add_argument("name", help="a law or case name")
     describe.set_defaults(run=run)
 

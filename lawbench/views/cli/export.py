@@ -7,10 +7,12 @@ import argparse
 from lawbench.core.case import CASES
 from lawbench.views.cli.common import _assignments, _path, add_assignments
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = ("export", {"help": "write a scene's problem to a file"})
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``export`` command."""
-    export = commands.add_parser("export", help="write a scene's problem to a file")
+
+def arguments(export: argparse.ArgumentParser) -> None:
+    """The arguments of the ``export`` command."""
     export.add_argument("case")
     add_assignments(export, "--set", help="a case parameter")
     export.add_argument(

@@ -15,12 +15,15 @@ from lawbench.views.cli.common import (
     add_assignments,
 )
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = (
+    "fit",
+    {"help": "identify a law's coefficients from measured pre/post-impact velocities"},
+)
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``fit`` command."""
-    fitp = commands.add_parser(
-        "fit", help="identify a law's coefficients from measured pre/post-impact velocities"
-    )
+
+def arguments(fitp: argparse.ArgumentParser) -> None:
+    """The arguments of the ``fit`` command."""
     fitp.add_argument("law", help="a law, or several comma-separated to compare them")
     fitp.add_argument("case", help="the scene of the experiment")
     fitp.add_argument(

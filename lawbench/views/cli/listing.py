@@ -7,10 +7,13 @@ import argparse
 from lawbench.core.case import CASES
 from lawbench.core.law import LAWS
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = ("list", {"help": "list the laws and cases"})
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``list`` command."""
-    commands.add_parser("list", help="list the laws and cases").set_defaults(run=run)
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    """The arguments of the ``list`` command."""
+    parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> None:

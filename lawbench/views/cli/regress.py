@@ -8,10 +8,12 @@ from lawbench.core.case import CASES
 from lawbench.core.law import LAWS
 from lawbench.views.cli.common import Drift, _names
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = ("regress", {"help": "compare every law with its baseline"})
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``regress`` command."""
-    regress = commands.add_parser("regress", help="compare every law with its baseline")
+
+def arguments(regress: argparse.ArgumentParser) -> None:
+    """The arguments of the ``regress`` command."""
     regress.add_argument("--update", action="store_true", help="rewrite the baselines")
     regress.add_argument("--laws", help="comma-separated laws")
     regress.add_argument("--cases", help="comma-separated cases")

@@ -7,10 +7,12 @@ import argparse
 from lawbench.files.paths import output_folder
 from lawbench.views.cli.common import _path
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = ("report", {"help": "write the comparison report"})
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``report`` command."""
-    report = commands.add_parser("report", help="write the comparison report")
+
+def arguments(report: argparse.ArgumentParser) -> None:
+    """The arguments of the ``report`` command."""
     report.add_argument("--out", type=_path, default="reports/latest", help="output folder")
     size = report.add_mutually_exclusive_group()
     size.add_argument(

@@ -26,17 +26,22 @@ LARGE_GRID = 10_000
 ESTIMATE_CELLS = 3
 
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``run`` command."""
-    run_ = commands.add_parser(
-        "run",
-        help="run a grid of laws x cases x parameters",
-        description="Run a grid of laws x cases x parameters x options into one tidy table. "
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = (
+    "run",
+    {
+        "help": "run a grid of laws x cases x parameters",
+        "description": "Run a grid of laws x cases x parameters x options into one tidy table. "
         "The grid comes from a TOML run file (see README) or from --laws/--cases/--param/--set; "
         "the first line printed is the grid as read. "
         "Grid points: --param e=0,0.5,1 is three rows; a per-contact vector: "
         '--param "e=[0.9,0.8]" is one row.',
-    )
+    },
+)
+
+
+def arguments(run_: argparse.ArgumentParser) -> None:
+    """The arguments of the ``run`` command."""
     run_.add_argument("spec", nargs="?", type=_path, help="a TOML run specification")
     run_.add_argument("--laws", help="comma-separated laws (default: every law that applies)")
     run_.add_argument("--cases", help="comma-separated cases (default: every case)")

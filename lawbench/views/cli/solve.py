@@ -6,26 +6,26 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
+from typing import Any
 
-from lawbench.checks import run_checks
-from lawbench.core.contact import ContactProblem
+import numpy as np
+
+from lawbench.checks import CheckResult, run_checks
+from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.law import LAWS
-from lawbench.core.transforms import apply
-from lawbench.core.trial import evaluate
+from lawbench.core.trial import Trial, make_trial
 from lawbench.files.facts import ProblemFile
-from lawbench.studies.guard import alarm
-from lawbench.studies.study import Job
 from lawbench.views.cli.common import _assignments, _path, _seconds, add_assignments
-from lawbench.views.serialize import contact_record, trial_record
 
 # Contacts whose impulses the text output of a contact-space solve lists (--json gives all).
 SHOWN_CONTACTS = 10
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = ("solve", {"help": "solve one case (or a problem file) with one law"})
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``solve`` command."""
-    solve = commands.add_parser("solve", help="solve one case (or a problem file) with one law")
+
+def arguments(solve: argparse.ArgumentParser) -> None:
+    """The arguments of the ``solve`` command."""
     solve.add_argument("law")
     solve.add_argument("case", nargs="?", help="a scene name (or give --problem FILE)")
     solve.add_argument(
@@ -90,12 +90,15 @@ def _solve(
 
     A file's own data add what they say of the outcome (a global FCLIB form's FC3D error).
     """
-    with alarm(args.max_seconds):
-        if isinstance(case, str):
-            trial = Job(args.law, case, params, options, args.transform or "").solve()
-        else:
-            trial = evaluate(args.law, apply(args.transform or "", case.problem), options)
-        record = trial_record(trial, run_checks(trial))
+    trial = make_trial(
+        args.law,
+        case,
+        params=params,
+        options=options,
+        transform=args.transform or "",
+        max_seconds=args.max_seconds,
+    )
+    record = trial_record(trial, run_checks(trial))
     if isinstance(case, ProblemFile):
         record["diagnostics"].update(case.facts.diagnostics(trial.outcome))
     return record
@@ -140,8 +143,7 @@ def _solve_contact(args: argparse.Namespace, read: ProblemFile, options: dict[st
             "--transform changes an impact problem; a contact-space problem (FCLIB's local "
             "form) is solved as it is"
         )
-    with alarm(args.max_seconds):
-        solution = LAWS.get(args.law).solve_contact(problem, **options)
+    solution = make_trial(args.law, read, options=options, max_seconds=args.max_seconds).outcome
     record = contact_record(args.law, problem, solution)
     if _printed_as_json(args, record):
         return
@@ -161,3 +163,60 @@ def _solve_contact(args: argparse.Namespace, read: ProblemFile, options: dict[st
 
 def _numbers(values: Sequence[float]) -> str:
     return ", ".join(f"{value:.6g}" for value in values)
+
+
+def plain(value: Any) -> Any:
+    """Return ``value`` with numpy arrays and scalars turned into lists, floats and ints."""
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return plain(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def trial_record(trial: Trial, checks: dict[str, CheckResult]) -> dict[str, Any]:
+    """The JSON object of ``lawbench solve --json``."""
+    outcome = trial.outcome
+    record = {
+        "law": trial.law.name,
+        "case": trial.scene,
+        "params": trial.params,
+        "coordinates": (
+            trial.case.coordinates(trial.params)
+            if trial.case is not None
+            else [f"v[{i}]" for i in range(trial.problem.n)]
+        ),
+        "v_minus": trial.problem.v,
+        "v_plus": outcome.v_plus,
+        "Pn": outcome.Pn,
+        "Pt": outcome.Pt,
+        "T_minus": outcome.T_minus,
+        "T_plus": outcome.T_plus,
+        "checks": {name: result.as_dict() for name, result in checks.items()},
+        "status": outcome.status,
+        "diagnostics": outcome.diagnostics,
+    }
+    if outcome.path is not None:
+        record["path"] = outcome.path
+    return plain(record)
+
+
+def contact_record(law: str, problem: ContactProblem, solution: ContactSolution) -> dict[str, Any]:
+    """The JSON object of ``lawbench solve --json`` on a contact-space problem (FCLIB local)."""
+    return plain(
+        {
+            "law": law,
+            "case": problem.name,
+            "contacts": problem.m,
+            "dim": problem.dim,
+            "status": "ok",
+            "r": solution.r,
+            "u": solution.u,
+            "fc3d_error": solution.fc3d_error,
+            "diagnostics": solution.diagnostics,
+        }
+    )

@@ -10,12 +10,15 @@ from lawbench.files.paths import output_file
 from lawbench.studies.declared import STUDIES
 from lawbench.views.cli.common import _assignments, _executor_arguments, _path, add_assignments
 
+# The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
+COMMAND = (
+    "study",
+    {"aliases": ["table"], "help": "run one study and print its table (table: the same)"},
+)
 
-def add(commands: argparse._SubParsersAction) -> None:
-    """Add the ``study`` command and its alias ``table``."""
-    study = commands.add_parser(
-        "study", aliases=["table"], help="run one study and print its table (table: the same)"
-    )
+
+def arguments(study: argparse.ArgumentParser) -> None:
+    """The arguments of the ``study`` command."""
     study.add_argument("name", nargs="?", help="a study (lawbench study --list)")
     study.add_argument("--list", action="store_true", help="list the studies with their titles")
     add_assignments(study, "--set", help="fix a scene parameter (a swept one is no longer swept)")
