@@ -1,4 +1,4 @@
-"""What the chain scenes share besides their problem: closed forms, ground truth and studies.
+"""What the chain scenes share: two-contact chains, closed forms, ground truth and studies.
 
 `lawbench.numerics.chains` builds the problems; this module holds the references of free chains,
 the ground truth of every chain scene (compliant integration at the scene's stiffnesses) and the
@@ -9,12 +9,44 @@ every contact elastic and with every contact plastic.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from lawbench.checks.knobs import decades
-from lawbench.core.case import GroundTruth, Reference
+from lawbench.core.case import Case, GroundTruth, Reference, exactly, per_item
+from lawbench.core.problem import ImpactProblem
+from lawbench.numerics.chains import Pair, chain_problem
+
+
+class TwoContactChain(Case):
+    """Balls on a line with two contacts, contact 0 of stiffness 1 and contact 1 of the ratio.
+
+    A subclass says which balls each contact joins (``pairs``, None for a fixed wall); the
+    parameters ``masses``, ``velocities`` and ``gaps`` take one value per ball or contact, ``e``
+    one value or one per contact.
+    """
+
+    pairs: ClassVar[tuple[Pair, Pair]]
+
+    def _check(self, params: dict[str, Any]) -> None:
+        balls = max(ball for pair in self.pairs for ball in pair if ball is not None) + 1
+        exactly(params, "masses", balls, "ball")
+        exactly(params, "velocities", balls, "ball")
+        exactly(params, "gaps", 2, "contact")
+        per_item(params, "e", 2, "contact")
+
+    def _build(self, params: dict[str, Any]) -> ImpactProblem:
+        return chain_problem(
+            params["masses"],
+            params["velocities"],
+            pairs=list(self.pairs),
+            restitution=params["e"],
+            stiffness=[1.0, params["stiffness_ratio"]],
+            exponents=[params["exponent"]] * 2,
+            gaps=params["gaps"],
+        )
+
 
 SPRINGS = GroundTruth(
     why="the chain's outcome depends on how the contacts' stiffnesses share the impact, which "

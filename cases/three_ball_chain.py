@@ -9,23 +9,20 @@ Brogliato, *An introduction to impact dynamics* (2010), three-ball chain, equati
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from lawbench.cases._chains import (
     NEWTONS_CRADLE,
     PLASTIC_CHAIN,
     SPRINGS,
+    TwoContactChain,
     masses_extremes,
     two_contact_studies,
 )
-from lawbench.core.case import CASES, Case, Params, Reference, exactly, per_item
-from lawbench.core.problem import ImpactProblem
+from lawbench.core.case import CASES, Params, Reference
 from lawbench.core.tags import Tags
 from lawbench.numerics.chains import (
     ball_velocities,
-    chain_problem,
     exponent_spec,
     gaps_spec,
     masses_spec,
@@ -68,7 +65,7 @@ def _moreau_as_newton(p: Params) -> str | None:
     return None
 
 
-class ThreeBallChain(Case):
+class ThreeBallChain(TwoContactChain):
     """Three balls on a line, touching, struck from the left by default."""
 
     name = "three_ball_chain"
@@ -82,6 +79,7 @@ class ThreeBallChain(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
+    pairs = ((0, 1), (1, 2))
     # The smallest multiple impact: its start-up is the cost of the smallest command.
     bench_roles = ("start_up",)
     ground_truth = SPRINGS
@@ -110,23 +108,6 @@ class ThreeBallChain(Case):
         "unequal masses": {"masses": [1.0, 10.0, 0.1], "e": [0.8]},
         "separating contact": {"velocities": [1.0, 0.0, 0.75]},
     }
-
-    def _check(self, params: dict[str, Any]) -> None:
-        exactly(params, "masses", 3, "ball")
-        exactly(params, "velocities", 3, "ball")
-        exactly(params, "gaps", 2, "contact")
-        per_item(params, "e", 2, "contact")
-
-    def _build(self, params: dict[str, Any]) -> ImpactProblem:
-        return chain_problem(
-            params["masses"],
-            params["velocities"],
-            pairs=[(0, 1), (1, 2)],
-            restitution=params["e"],
-            stiffness=[1.0, params["stiffness_ratio"]],
-            exponents=[params["exponent"]] * 2,
-            gaps=params["gaps"],
-        )
 
     def coordinates(self, params: Params) -> list[str]:
         """Velocities of balls 1, 2, 3."""

@@ -11,17 +11,13 @@ binary impacts depend on their order.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
-from lawbench.cases._chains import SPRINGS, two_contact_studies
-from lawbench.core.case import CASES, Case, Params, Reference, exactly, per_item
-from lawbench.core.problem import ImpactProblem
+from lawbench.cases._chains import SPRINGS, TwoContactChain, two_contact_studies
+from lawbench.core.case import CASES, Params, Reference
 from lawbench.core.tags import Tags
 from lawbench.numerics.chains import (
     ball_velocities,
-    chain_problem,
     exponent_spec,
     gaps_spec,
     masses_spec,
@@ -86,7 +82,7 @@ def _ends_after_28(p: Params) -> str | None:
     return None
 
 
-class TwoBallsWall(Case):
+class TwoBallsWall(TwoContactChain):
     """Ball 1 on ball 2 on a wall, both falling onto it."""
 
     name = "two_balls_wall"
@@ -100,6 +96,7 @@ class TwoBallsWall(Case):
         gaps_spec(2),
     )
     requires = Tags(several_contacts=True)
+    pairs = ((1, 0), (None, 1))
     ground_truth = SPRINGS
     references = (
         Reference(
@@ -127,23 +124,6 @@ class TwoBallsWall(Case):
         "separating ball": {"velocities": [-1.0, 0.5], "e": [0.5]},
         "stiff wall": {"stiffness_ratio": 100.0},
     }
-
-    def _check(self, params: dict[str, Any]) -> None:
-        exactly(params, "masses", 2, "ball")
-        exactly(params, "velocities", 2, "ball")
-        exactly(params, "gaps", 2, "contact")
-        per_item(params, "e", 2, "contact")
-
-    def _build(self, params: dict[str, Any]) -> ImpactProblem:
-        return chain_problem(
-            params["masses"],
-            params["velocities"],
-            pairs=[(1, 0), (None, 1)],
-            restitution=params["e"],
-            stiffness=[1.0, params["stiffness_ratio"]],
-            exponents=[params["exponent"]] * 2,
-            gaps=params["gaps"],
-        )
 
     def coordinates(self, params: Params) -> list[str]:
         """Velocities of ball 1 (outer) and ball 2, away from the wall."""

@@ -26,6 +26,7 @@ from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, 
 from lawbench.core.law import LAWS
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
+from lawbench.core.trial import make_trial
 from lawbench.studies.guard import TIME_OUT, Guard, Result
 
 # The extensions of the problem files read (`lawbench.files.problem_files.load_problem`).
@@ -157,9 +158,7 @@ def _solve(
         options["max_steps"] = MAX_STEPS
     if "tol" in specs:
         options["tol"] = tol
-    if isinstance(problem, ContactProblem):
-        return LAWS[law].solve_contact(problem, **options)
-    return LAWS[law].resolve(problem, **options)
+    return make_trial(law, problem, options=options).outcome
 
 
 def bench_problems(
