@@ -16,7 +16,17 @@ import numpy as np
 from lawbench.checks.knobs import decades
 from lawbench.core.case import Case, GroundTruth, Reference, exactly, per_item
 from lawbench.core.problem import ImpactProblem
-from lawbench.numerics.chains import Pair, chain_problem
+from lawbench.core.spec import Spec
+from lawbench.numerics.chains import (
+    Pair,
+    chain_problem,
+    exponent_spec,
+    gaps_spec,
+    masses_spec,
+    restitution_spec,
+    stiffness_ratio_spec,
+    velocities_spec,
+)
 
 
 class TwoContactChain(Case):
@@ -28,6 +38,18 @@ class TwoContactChain(Case):
     """
 
     pairs: ClassVar[tuple[Pair, Pair]]
+
+    @staticmethod
+    def specs(velocities: list[float], velocities_doc: str, ratio_doc: str) -> tuple[Spec, ...]:
+        """The parameters, unit masses and the given pre-impact ``velocities`` by default."""
+        return (
+            masses_spec([1.0] * len(velocities)),
+            velocities_spec(velocities, velocities_doc),
+            restitution_spec(),
+            stiffness_ratio_spec(ratio_doc),
+            exponent_spec(),
+            gaps_spec(2),
+        )
 
     def _check(self, params: dict[str, Any]) -> None:
         balls = max(ball for pair in self.pairs for ball in pair if ball is not None) + 1

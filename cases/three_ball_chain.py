@@ -21,15 +21,7 @@ from lawbench.cases._chains import (
 )
 from lawbench.core.case import CASES, Params, Reference
 from lawbench.core.tags import Tags
-from lawbench.numerics.chains import (
-    ball_velocities,
-    exponent_spec,
-    gaps_spec,
-    masses_spec,
-    restitution_spec,
-    stiffness_ratio_spec,
-    velocities_spec,
-)
+from lawbench.numerics.chains import ball_velocities
 
 
 def _equation_29(p: Params) -> np.ndarray:
@@ -70,13 +62,10 @@ class ThreeBallChain(TwoContactChain):
 
     name = "three_ball_chain"
     summary = "three balls on a line, touching (Brogliato 2010, eq. 29)"
-    params = (
-        masses_spec([1.0, 1.0, 1.0]),
-        velocities_spec([1.0, 0.0, 0.0], "pre-impact velocities of balls 1, 2, 3"),
-        restitution_spec(),
-        stiffness_ratio_spec("stiffness of contact 1 over contact 0"),
-        exponent_spec(),
-        gaps_spec(2),
+    params = TwoContactChain.specs(
+        [1.0, 0.0, 0.0],
+        "pre-impact velocities of balls 1, 2, 3",
+        "stiffness of contact 1 over contact 0",
     )
     requires = Tags(several_contacts=True)
     pairs = ((0, 1), (1, 2))

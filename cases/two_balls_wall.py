@@ -16,15 +16,7 @@ import numpy as np
 from lawbench.cases._chains import SPRINGS, TwoContactChain, two_contact_studies
 from lawbench.core.case import CASES, Params, Reference
 from lawbench.core.tags import Tags
-from lawbench.numerics.chains import (
-    ball_velocities,
-    exponent_spec,
-    gaps_spec,
-    masses_spec,
-    restitution_spec,
-    stiffness_ratio_spec,
-    velocities_spec,
-)
+from lawbench.numerics.chains import ball_velocities
 
 
 def _unpack(p: Params) -> tuple[float, float, float, float, float]:
@@ -87,13 +79,10 @@ class TwoBallsWall(TwoContactChain):
 
     name = "two_balls_wall"
     summary = "ball 1 on ball 2 on a fixed wall (Brogliato 2010, eqs. 25-28)"
-    params = (
-        masses_spec([1.0, 1.0]),
-        velocities_spec([-1.0, -1.0], "pre-impact velocities of ball 1 (outer) and ball 2"),
-        restitution_spec(),
-        stiffness_ratio_spec("stiffness of the wall contact over the ball contact"),
-        exponent_spec(),
-        gaps_spec(2),
+    params = TwoContactChain.specs(
+        [-1.0, -1.0],
+        "pre-impact velocities of ball 1 (outer) and ball 2",
+        "stiffness of the wall contact over the ball contact",
     )
     requires = Tags(several_contacts=True)
     pairs = ((1, 0), (None, 1))
