@@ -10,7 +10,7 @@ from lawbench.core.spec import Spec
 
 def positive(name: str, default: float, doc: str, unit: str) -> Spec:
     """A real number above zero (a length, a mass, a speed)."""
-    return Spec(name, default, doc, unit, kind="float", low=0.0, low_open=True)
+    return Spec(name, default, doc, unit=unit, kind="float", low=0.0, low_open=True)
 
 
 def mass(default: float, doc: str) -> Spec:
@@ -23,10 +23,10 @@ def restitution(
 ) -> Spec:
     """The restitution ``e`` in [0, 1]: one number, or a list (one per contact) for a list."""
     kind = "floats" if isinstance(default, list) else "float"
-    return Spec("e", default, doc, "", kind=kind, low=0.0, high=1.0)
+    return Spec("e", default, doc, kind=kind, low=0.0, high=1.0)
 
 
 def friction(default: float | list[float], doc: str = "Coulomb friction coefficient") -> Spec:
     """Coulomb's ``mu`` >= 0: one number, or a list (one per contact) for a list."""
     kind = "floats" if isinstance(default, list) else "float"
-    return Spec("mu", default, doc, "", kind=kind, low=0.0)
+    return Spec("mu", default, doc, kind=kind, low=0.0)

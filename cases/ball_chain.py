@@ -45,18 +45,20 @@ class BallChain(Case):
     name = "ball_chain"
     summary = "n balls on a line, touching, optionally against a wall on the right"
     params = (
-        Spec("n", 5, "number of balls", "", "int", 2, 100_000),
+        Spec("n", 5, "number of balls", kind="int", low=2, high=100_000),
         masses_spec([1.0]),
         velocities_spec([1.0], "pre-impact velocities of the first balls; the rest are at rest"),
         restitution_spec(),
-        Spec("wall", False, "a fixed wall right of the last ball, as the last contact", "", "bool"),
+        Spec(
+            "wall", False, "a fixed wall right of the last ball, as the last contact", kind="bool"
+        ),
         Spec(
             "stiffness",
             [1.0],
             "contact stiffness, one value or one per contact",
-            "N/m^exponent",
-            "floats",
-            0.0,
+            unit="N/m^exponent",
+            kind="floats",
+            low=0.0,
             low_open=True,
         ),
         exponent_spec("floats"),

@@ -46,7 +46,7 @@ class BeadColumn(Case):
     name = "bead_column"
     summary = "a column of steel beads dropped onto a wall (Falcon et al. 1998)"
     params = (
-        Spec("n", 10, "number of beads", "", "int", 1, 1000),
+        Spec("n", 10, "number of beads", kind="int", low=1, high=1000),
         _specs.positive("drop_height", 3.1e-3, "height the column falls from", "m"),
         restitution_spec(),
     )

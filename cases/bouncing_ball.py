@@ -128,7 +128,7 @@ def frictionless_reference(case: type[Case]) -> Reference:
 
 def vector_spec(name: str, default: list[float], doc: str, unit: str) -> Spec:
     """A three-component parameter."""
-    return Spec(name, default, doc, unit, "floats")
+    return Spec(name, default, doc, unit=unit, kind="floats")
 
 
 def contact_specs(e: float, mu: float, ratio: float) -> tuple[Spec, ...]:
@@ -140,9 +140,7 @@ def contact_specs(e: float, mu: float, ratio: float) -> tuple[Spec, ...]:
             "tangential_stiffness_ratio",
             ratio,
             "Jia's eta0^2: normal (compression) over tangential stiffness",
-            "",
-            "float",
-            0.0,
+            low=0.0,
             low_open=True,
         ),
     )

@@ -96,22 +96,21 @@ class DiskBall(Case):
     name = "disk_ball"
     summary = "ball striking a disk standing on a rough floor (Zhang, Liu, Zhao, Brogliato 2013)"
     params = (
-        Spec("b", 0.02, "impact height above the disk's centre, on its axis", "m", "float"),
+        Spec("b", 0.02, "impact height above the disk's centre, on its axis", unit="m"),
         _specs.positive("vb", 1.0, "ball speed towards the disk", "m/s"),
         _specs.positive("radius", 0.05, "disk radius r", "m"),
         _specs.positive("half_thickness", 0.005, "half the disk's thickness, h", "m"),
         _specs.positive("disk_mass", 0.5, "disk mass md", "kg"),
         _specs.positive("ball_mass", 0.02, "ball mass mb", "kg"),
-        Spec("mu_floor", 0.3, "Coulomb friction at the floor points A, B, C", "", "float", 0.0),
-        Spec("mu_ball", 0.2, "Coulomb friction between ball and disk (D)", "", "float", 0.0),
+        Spec("mu_floor", 0.3, "Coulomb friction at the floor points A, B, C", low=0.0),
+        Spec("mu_ball", 0.2, "Coulomb friction between ball and disk (D)", low=0.0),
         Spec(
             "e",
             [0.6],
             "Stronge's energetic restitution, one value or one per contact A, B, C, D",
-            "",
-            "floats",
-            0.0,
-            1.0,
+            kind="floats",
+            low=0.0,
+            high=1.0,
         ),
         stiffness_ratio_spec("stiffness of each floor point over that of the ball contact"),
         exponent_spec(),

@@ -81,10 +81,9 @@ class PingPong(TwoBallsWall):
             "e",
             list(MEASURED_E),
             "restitution, ball-ball then ball-table (one value serves both)",
-            "",
-            "floats",
-            0.0,
-            1.0,
+            kind="floats",
+            low=0.0,
+            high=1.0,
         ),
         dataclasses.replace(
             stiffness_ratio_spec("stiffness of the table contact over the ball contact, k2/k1"),

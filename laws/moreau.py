@@ -178,18 +178,15 @@ class Moreau(Law):
             1e-10,
             "clarabel's tolerances (gap and feasibility); with friction also the fixed point's "
             "(change of mu |ut+| over the largest local velocity)",
-            "",
-            "float",
-            0.0,
-            1e-2,
-            True,
+            low=0.0,
+            high=1e-2,
+            low_open=True,
         ),
         Spec(
             "polish",
             True,
             "solve clarabel's active set (with friction: contact states) exactly",
-            "",
-            "bool",
+            kind="bool",
         ),
         Spec(
             "separating",
@@ -218,9 +215,8 @@ class Moreau(Law):
             1000,
             "bound on the cone QPs of the exact Coulomb law's fixed point, or on the sweeps of "
             "Gauss-Seidel (granular problems take thousands: raise it for them)",
-            "",
-            "int",
-            1,
+            kind="int",
+            low=1,
         ),
     )
 

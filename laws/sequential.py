@@ -66,12 +66,11 @@ class Sequential(Law):
             "order",
             "left_to_right",
             "which approaching contact goes next",
-            "",
-            "str",
+            kind="str",
             choices=ORDERS,
         ),
-        Spec("max_steps", 1_000_000, "bound on the number of binary impacts", "", "int", 1),
-        Spec("path", False, "return the velocities after each binary impact", "", "bool"),
+        Spec("max_steps", 1_000_000, "bound on the number of binary impacts", kind="int", low=1),
+        Spec("path", False, "return the velocities after each binary impact", kind="bool"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -40,7 +40,7 @@ def test_building_coerces_each_parameter_once(coerced):
 
 
 def test_a_list_of_1000_floats_is_checked_without_a_call_per_item(monkeypatch):
-    spec = Spec("masses", [1.0], "ball masses", "kg", "floats", 0.0, low_open=True)
+    spec = Spec("masses", [1.0], "ball masses", unit="kg", kind="floats", low=0.0, low_open=True)
     calls = Counter()
     number = Spec._number
 
@@ -63,7 +63,7 @@ def test_a_list_of_1000_floats_is_checked_without_a_call_per_item(monkeypatch):
     ],
 )
 def test_a_bad_item_of_a_list_is_named_by_its_index(value, message):
-    spec = Spec("masses", [1.0], "ball masses", "kg", "floats", 0.0, low_open=True)
+    spec = Spec("masses", [1.0], "ball masses", unit="kg", kind="floats", low=0.0, low_open=True)
     with pytest.raises(InvalidProblem, match=message):
         spec.coerce(value)
 

@@ -24,7 +24,7 @@ from lawbench.core.errors import BudgetExceeded
 from lawbench.core.spec import Spec
 
 OPTION = Spec(
-    "max_seconds", 60.0, "wall-clock budget of one solve", "s", "float", 0.0, low_open=True
+    "max_seconds", 60.0, "wall-clock budget of one solve", unit="s", low=0.0, low_open=True
 )
 
 

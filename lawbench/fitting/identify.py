@@ -36,15 +36,20 @@ from lawbench.fitting.uncertainty import FLAT_TOL, summarize
 RANGES = {
     spec.name: spec
     for spec in (
-        Spec("noise", None, "a measured velocity's standard deviation", "m/s", "float", 1e-12, 1e6),
-        Spec("holdout", 0.0, "share of the trials kept out", "", "float", 0.0, 1.0, high_open=True),
-        Spec("bootstrap", 0, "refits on resampled trials", "", "int", 0, 100_000),
-        Spec("seed", 0, "seed of the resampling", "", "int", 0),
-        Spec("tol", 1e-10, "tolerance of the least squares", "", "float", 1e-15, 0.1),
-        Spec("diff_step", 1e-6, "relative step of the finite differences", "", "float", 1e-12, 0.1),
         Spec(
-            "flat_tol", FLAT_TOL, "singular value ratio of a flat direction", "", "float", 0.0, 0.5
+            "noise",
+            None,
+            "a measured velocity's standard deviation",
+            unit="m/s",
+            low=1e-12,
+            high=1e6,
         ),
+        Spec("holdout", 0.0, "share of the trials kept out", low=0.0, high=1.0, high_open=True),
+        Spec("bootstrap", 0, "refits on resampled trials", kind="int", low=0, high=100_000),
+        Spec("seed", 0, "seed of the resampling", kind="int", low=0),
+        Spec("tol", 1e-10, "tolerance of the least squares", low=1e-15, high=0.1),
+        Spec("diff_step", 1e-6, "relative step of the finite differences", low=1e-12, high=0.1),
+        Spec("flat_tol", FLAT_TOL, "singular value ratio of a flat direction", low=0.0, high=0.5),
     )
 }
 

@@ -87,18 +87,31 @@ def ball_velocities(balls: int) -> list[str]:
 
 def masses_spec(default: list[float]) -> Spec:
     """The ``masses`` parameter of a chain scene."""
-    return Spec("masses", default, "ball masses, left to right", "kg", "floats", 0.0, low_open=True)
+    return Spec(
+        "masses",
+        default,
+        "ball masses, left to right",
+        unit="kg",
+        kind="floats",
+        low=0.0,
+        low_open=True,
+    )
 
 
 def velocities_spec(default: list[float], doc: str) -> Spec:
     """The ``velocities`` parameter of a chain scene (pre-impact ball velocities)."""
-    return Spec("velocities", default, doc, "m/s", "floats")
+    return Spec("velocities", default, doc, unit="m/s", kind="floats")
 
 
 def restitution_spec() -> Spec:
     """The ``e`` parameter: one restitution coefficient for all contacts, or one per contact."""
     return Spec(
-        "e", [1.0], "restitution coefficient, one value or one per contact", "", "floats", 0.0, 1.0
+        "e",
+        [1.0],
+        "restitution coefficient, one value or one per contact",
+        kind="floats",
+        low=0.0,
+        high=1.0,
     )
 
 
@@ -111,20 +124,24 @@ def exponent_spec(kind: str = "float") -> Spec:
         "exponent",
         1.5 if kind == "float" else [1.5],
         "force-indentation exponent (1 linear, 1.5 Hertz)",
-        "",
-        kind,
-        0.0,
+        kind=kind,
+        low=0.0,
         low_open=True,
     )
 
 
 def stiffness_ratio_spec(doc: str) -> Spec:
     """The ``stiffness_ratio`` parameter (contact 0 has stiffness 1 N/m^exponent)."""
-    return Spec("stiffness_ratio", 1.0, doc, "", "float", 0.0, low_open=True)
+    return Spec("stiffness_ratio", 1.0, doc, low=0.0, low_open=True)
 
 
 def gaps_spec(count: int) -> Spec:
     """The ``gaps`` parameter: initial gap of each contact, zero by default."""
     return Spec(
-        "gaps", [0.0] * count, "initial gap of each contact (0: in contact)", "m", "floats", 0.0
+        "gaps",
+        [0.0] * count,
+        "initial gap of each contact (0: in contact)",
+        unit="m",
+        kind="floats",
+        low=0.0,
     )

@@ -119,7 +119,9 @@ class Compliant(Law):
     )
     options = (
         Spec("model", "hunt_crossley", "force law of every contact", kind="str", choices=MODELS),
-        Spec("tol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),
+        Spec(
+            "tol", 1e-10, "relative tolerance of the integrator", low=0.0, high=1e-2, low_open=True
+        ),
         Spec(
             "termination",
             "force",
@@ -141,9 +143,9 @@ class Compliant(Law):
             kind="str",
             choices=("auto", "DOP853", "RK45", "Radau", "LSODA"),
         ),
-        Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
-        Spec("max_events", 100_000, "budget of restarts at contact events", "", "int", 1),
-        Spec("path", False, "return time histories of forces and stored energies", "", "bool"),
+        Spec("max_steps", 200_000, "budget of integrator steps", kind="int", low=1),
+        Spec("max_events", 100_000, "budget of restarts at contact events", kind="int", low=1),
+        Spec("path", False, "return time histories of forces and stored energies", kind="bool"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -115,19 +115,16 @@ class DarbouxKeller(Law):
             "tol",
             1e-9,
             "relative tolerance of the ODE of turning spatial slip (planar problems are exact)",
-            "",
-            "float",
-            1e-13,
-            1e-2,
+            low=1e-13,
+            high=1e-2,
         ),
         Spec(
             "path",
             False,
             "return impulses, contact velocities and work along the impact",
-            "",
-            "bool",
+            kind="bool",
         ),
-        Spec("max_steps", 100_000, "budget of integrator steps of turning slip", "", "int", 1),
+        Spec("max_steps", 100_000, "budget of integrator steps of turning slip", kind="int", low=1),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

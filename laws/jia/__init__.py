@@ -136,21 +136,18 @@ class Jia(Law):
             "tol",
             1e-11,
             "relative tolerance of the integration along the impact",
-            "",
-            "float",
-            0.0,
-            1e-2,
+            low=0.0,
+            high=1e-2,
             low_open=True,
         ),
         Spec(
             "path",
             False,
             "return the impulse curve (impulses, spring energies, contact velocities)",
-            "",
-            "bool",
+            kind="bool",
         ),
-        Spec("max_steps", 1_000_000, "budget of integrator steps", "", "int", 1),
-        Spec("max_events", 10_000, "budget of contact state transitions", "", "int", 1),
+        Spec("max_steps", 1_000_000, "budget of integrator steps", kind="int", low=1),
+        Spec("max_events", 10_000, "budget of contact state transitions", kind="int", low=1),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -163,18 +163,19 @@ class LiuZhaoBrogliato(Law):
             kind="str",
             choices=("bi", "mono"),
         ),
-        Spec("tol", 1e-10, "relative tolerance of the integrator", "", "float", 0.0, 1e-2, True),
+        Spec(
+            "tol", 1e-10, "relative tolerance of the integrator", low=0.0, high=1e-2, low_open=True
+        ),
         Spec(
             "method", "DOP853", "solve_ivp method", kind="str", choices=("DOP853", "RK45", "Radau")
         ),
-        Spec("max_steps", 200_000, "budget of integrator steps", "", "int", 1),
-        Spec("max_events", 20_000, "budget of restarts at events", "", "int", 1),
+        Spec("max_steps", 200_000, "budget of integrator steps", kind="int", low=1),
+        Spec("max_events", 20_000, "budget of restarts at events", kind="int", low=1),
         Spec(
             "path",
             False,
             "return impulses, velocities and stored energies along the impact",
-            "",
-            "bool",
+            kind="bool",
         ),
     )
 
