@@ -169,6 +169,9 @@ class SpringImpact:
         self.record = Record()
         self.stick = np.ones(self.m, dtype=bool)
         self.direction = np.zeros((self.m, self.d))
+        # The stick margin at which a contact began to stick, where rounding left it above 0 (a
+        # spring held at its bound while slipping): its slip fires when the margin passes it.
+        self.excess = np.zeros(self.m)
         for j in np.flatnonzero(self.active & self.rough):
             self._start_friction(j, u_minus)
         diag = np.diag(G)[: self.m] * self.kappa
@@ -320,7 +323,7 @@ class SpringImpact:
             if releases.size:
                 out[releases] = self.lock[release_rows] @ self._spring_rate(s)
             for i in slip:
-                out[i] = self._stick_margin(int(contacts[i]), s)
+                out[i] = self._stick_margin(int(contacts[i]), s) - self.excess[contacts[i]]
             for i in stick:
                 out[i] = self._slip_speed(int(contacts[i]), s, u)
             return out
@@ -344,7 +347,7 @@ class SpringImpact:
         tau, s = 0.0, np.zeros(2 * (self.m + self.nt))
         self._note_state(tau, s, ["stick" if self.stick[0] else "slip"] if self.nt else [])
         while True:
-            s = self._settle(s)
+            s = self._settle(tau, s)
             if not self.active.any():
                 return s
             armed = self._events()
@@ -377,12 +380,18 @@ class SpringImpact:
         if self.keep_path:
             self.record.samples.append(np.append(tau, dense(tau)))
 
-    def _settle(self, s: np.ndarray) -> np.ndarray:
-        """Separate emptied springs, reactivate approaching contacts, release pulling locks.
+    def _settle(self, tau: float, s: np.ndarray) -> np.ndarray:
+        """Stop finished slips, empty springs, reactivate contacts, release pulling locks.
 
-        A spring that empties at the instant of another event is already at (or, by rounding,
-        just past) zero, where its own separation event cannot fire.
+        A transition of another kind can leave a state past an event's zero, where its own event
+        cannot fire: a slip whose speed the end of a compression (a stiffer spring) turned
+        negative, a spring that empties at the instant of another event.
         """
+        u = self.velocity(s)
+        for j in np.flatnonzero(self.active & self.rough & ~self.stick):
+            if self._slip_speed(int(j), s, u) < 0.0:
+                s = self._apply("stick", int(j), s)
+                self._note_state(tau, s, ["stick"])
         expanding = self.active & ~self.compressing
         emptied = expanding & (s[self.m : 2 * self.m] <= ROUNDING * self.scale[self.m])
         for j in np.flatnonzero(emptied):
@@ -470,6 +479,7 @@ class SpringImpact:
             self.direction[j] = self._ghat(j, self._tangential(s[self.g], j))
         else:
             self.stick[j] = True
+            self.excess[j] = max(self._stick_margin(j, s), 0.0)
         return s
 
     def _note_state(self, tau: float, s: np.ndarray, fired: list[str]) -> None:
