@@ -26,7 +26,7 @@ LAYERS = (
     ("lawbench.core",),
     ("lawbench.numerics", "lawbench.files"),
     ("lawbench.checks",),
-    ("lawbench.laws", "lawbench.cases"),
+    ("lawbench.laws", "lawbench.cases", "lawbench.measurements"),
     ("lawbench.studies",),
     ("lawbench.views",),
 )

@@ -1,0 +1,4 @@
+"""The built-in measurement sets, one module each; importing this package registers them.
+
+A set's module registers a `MeasurementSet` that reads its data file only on first use.
+"""
