@@ -2,3 +2,7 @@
 
 A set's module registers a `MeasurementSet` that reads its data file only on first use.
 """
+
+from lawbench.measurements.sets import ellipse
+
+__all__ = ["ellipse"]
