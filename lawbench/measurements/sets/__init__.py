@@ -3,6 +3,6 @@
 A set's module registers a `MeasurementSet` that reads its data file only on first use.
 """
 
-from lawbench.measurements.sets import ellipse, kharaz
+from lawbench.measurements.sets import cube, ellipse, kharaz
 
-__all__ = ["ellipse", "kharaz"]
+__all__ = ["cube", "ellipse", "kharaz"]
