@@ -236,7 +236,9 @@ def processing_array(processing: Processing) -> np.ndarray:
     return np.array(json.dumps(record, sort_keys=True))
 
 
-def planar_problem(M: np.ndarray, normal: np.ndarray, tangent: np.ndarray, v: np.ndarray):
+def planar_problem(
+    M: np.ndarray, normal: np.ndarray, tangent: np.ndarray, v: np.ndarray
+) -> ImpactProblem:
     """The one-contact planar problem with rows ``normal`` and ``tangent`` of the contact.
 
     The contact's coefficients are the placeholders ``e = 0``, ``mu = 0`` a fit replaces.

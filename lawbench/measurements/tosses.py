@@ -158,7 +158,9 @@ def _windows(z: np.ndarray, rules: Extraction) -> tuple[slice, slice] | str:
     return before, slice(start_after, min(end_after, start_after + rules.most))
 
 
-def _landing(flight: Flight, vertices: np.ndarray, table: float, start: float, end: float):
+def _landing(
+    flight: Flight, vertices: np.ndarray, table: float, start: float, end: float
+) -> float | None:
     """The first time in [start, end] the fitted flight brings a vertex to the table, or None."""
     for time in np.linspace(start, end, 241):
         position, _, rotation = flight.at(time)

@@ -59,13 +59,17 @@ def mass_matrix() -> np.ndarray:
 def _load() -> tuple[list[MeasuredImpact], np.ndarray, Processing]:
     data = read_data(NAME)
     M = mass_matrix()
-    impacts = []
-    for index in np.flatnonzero(~data["flags"].any(axis=1)):
-        problem = planar_problem(
-            M, data["normal"][index], data["tangent"][index], data["v_before"][index]
-        )
-        impacts.append(MeasuredImpact(problem, data["v_after"][index], None, NAME, int(index)))
     kept = ~data["flags"].any(axis=1)
+    impacts = [
+        MeasuredImpact(
+            planar_problem(M, data["normal"][i], data["tangent"][i], data["v_before"][i]),
+            data["v_after"][i],
+            None,
+            NAME,
+            int(i),
+        )
+        for i in np.flatnonzero(kept)
+    ]
     return impacts, data["train"][kept], processing_from(data)
 
 
