@@ -30,7 +30,7 @@ LAYERS = (
     ("lawbench.core",),
     ("lawbench.numerics", "lawbench.files"),
     ("lawbench.checks",),
-    ("lawbench.laws", "lawbench.cases"),
+    ("lawbench.laws", "lawbench.cases", "lawbench.measurements"),
     ("lawbench.studies",),
     ("lawbench.bench", "lawbench.fitting"),
     ("lawbench.views",),

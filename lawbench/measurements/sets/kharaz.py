@@ -1,0 +1,156 @@
+"""Oblique impacts of an alumina sphere on a glass anvil (Kharaz, Gorham and Salman 2001).
+
+A 5 mm alumina sphere (density 3960 kg/m^3) strikes a thick glass anvil at 3.9 m/s, without
+spin, at incidences from near-normal to grazing. Only points digitized from the paper's figures
+are public; those shipped here are the readings in NETL MFiX's test ``tests/dem/DEM05``
+(taken there from Di Renzo and Di Maio's reproduction of Kharaz's figures, Chem. Eng. Sci.
+59, 2004): the tangential restitution of the centre ``vx+ / vx-`` (8 points), the rebound spin
+(7 points, rad/s) and the rebound angle of the centre from the normal (9 points, degrees),
+each against the incidence angle from the normal (degrees).
+
+The set is the setup and the curves (`SETUP`, `curves`), and also measured impacts, one at
+each incidence of the tangential restitution where the spin was digitized around it: the spin
+is interpolated linearly in incidence, and the normal rebound takes ``e_n = 0.98``, the value
+DEM benchmarks use for this pair (the digitized points do not give it). Planar coordinates are
+``(vx, vy, omega)`` of the centre, x along the approach's tangential direction, y the anvil's
+normal, omega counterclockwise; the contact point lies at ``(0, -R)``, so friction spins the
+sphere clockwise and the rebound spin is stored negative.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from lawbench.measurements.impacts import (
+    MEASUREMENTS,
+    MeasuredImpact,
+    MeasurementSet,
+    Processing,
+    Source,
+    planar_problem,
+    processing_from,
+    read_data,
+)
+
+NAME = "kharaz"
+# The quantities digitized, as (incidence key, value key) in the data file.
+QUANTITIES = {
+    "tangential_restitution": ("incidence_et", "et"),
+    "rebound_spin": ("incidence_spin", "spin"),
+    "rebound_angle": ("incidence_angle", "rebound_angle"),
+}
+# The normal restitution of alumina on glass that DEM benchmarks use for this experiment.
+NORMAL_RESTITUTION = 0.98
+SOURCE = Source(
+    paper=(
+        "A. H. Kharaz, D. A. Gorham, A. D. Salman, An experimental study of the elastic "
+        "rebound of spheres, Powder Technology 120 (2001) 281-291; points as digitized by "
+        "A. Di Renzo, F. P. Di Maio, Chem. Eng. Sci. 59 (2004) 525-541"
+    ),
+    repository="https://github.com/soufiane92/MFiX-21.3.2 (a copy of NETL MFiX 21.3.2)",
+    commit="e8a0d92f47910deaf2a20b1365aeb1af2adc2c5f",
+    path="tests/dem/DEM05/write_usr0.f",
+    licence=(
+        "MFiX is public-domain software of the U.S. DOE's NETL; the copy read states no "
+        "licence file of its own"
+    ),
+)
+
+
+@dataclass(frozen=True)
+class Setup:
+    """The measured setup: a sphere without initial spin striking a fixed plane.
+
+    Attributes
+    ----------
+    radius : float
+        Sphere radius (m).
+    density : float
+        Alumina's density (kg/m^3).
+    speed : float
+        Impact speed (m/s).
+    """
+
+    radius: float = 2.5e-3
+    density: float = 3960.0
+    speed: float = 3.9
+
+    @property
+    def mass(self) -> float:
+        """The sphere's mass (kg)."""
+        return self.density * 4.0 / 3.0 * math.pi * self.radius**3
+
+    @property
+    def inertia(self) -> float:
+        """The solid sphere's moment of inertia about its centre, ``2 m R^2 / 5``."""
+        return 0.4 * self.mass * self.radius**2
+
+    def mass_matrix(self) -> np.ndarray:
+        """``diag(m, m, I)`` in the planar coordinates ``(vx, vy, omega)``."""
+        return np.diag([self.mass, self.mass, self.inertia])
+
+    def velocity_before(self, incidence: float) -> np.ndarray:
+        """The velocity before an impact at ``incidence`` degrees from the normal."""
+        angle = math.radians(incidence)
+        return np.array([self.speed * math.sin(angle), -self.speed * math.cos(angle), 0.0])
+
+    def impact(
+        self, incidence: float, restitution: float, spin: float, index: int
+    ) -> MeasuredImpact:
+        """The measured impact at ``incidence`` (degrees from the normal).
+
+        Rebuilt from the centre's tangential restitution and the rebound spin's magnitude
+        (rad/s), with ``NORMAL_RESTITUTION`` for the normal rebound; the contact point is
+        ``(0, -R)``.
+        """
+        v = self.velocity_before(incidence)
+        after = np.array([restitution * v[0], -NORMAL_RESTITUTION * v[1], -spin])
+        normal = np.array([0.0, 1.0, 0.0])
+        tangent = np.array([1.0, 0.0, self.radius])
+        problem = planar_problem(self.mass_matrix(), normal, tangent, v)
+        facts = {"incidence_deg": incidence, "normal_restitution": NORMAL_RESTITUTION}
+        return MeasuredImpact(problem, after, None, NAME, index, facts)
+
+
+SETUP = Setup()
+
+
+def curves() -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The digitized points per quantity: ``(incidence in degrees, value)``."""
+    data = read_data(NAME)
+    return {name: (data[x], data[y]) for name, (x, y) in QUANTITIES.items()}
+
+
+def _load() -> tuple[list[MeasuredImpact], np.ndarray, Processing]:
+    data = read_data(NAME)
+    low, high = data["incidence_spin"][0], data["incidence_spin"][-1]
+    impacts = []
+    for rank, (incidence, restitution) in enumerate(
+        zip(data["incidence_et"], data["et"], strict=True)
+    ):
+        if low <= incidence <= high:
+            spin = float(np.interp(incidence, data["incidence_spin"], data["spin"]))
+            impacts.append(SETUP.impact(float(incidence), float(restitution), spin, rank))
+    return impacts, data["train"], processing_from(data)
+
+
+KHARAZ = MEASUREMENTS.register(
+    MeasurementSet(
+        NAME,
+        "oblique impacts of a 5 mm alumina sphere on glass at 3.9 m/s, digitized curves",
+        SOURCE,
+        _load,
+        facts={
+            "radius": SETUP.radius,
+            "density": SETUP.density,
+            "speed": SETUP.speed,
+            "mass": SETUP.mass,
+            "inertia": SETUP.inertia,
+            "normal_restitution": NORMAL_RESTITUTION,
+            "dem_friction": 0.092,
+        },
+    )
+)
