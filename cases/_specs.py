@@ -13,6 +13,11 @@ def positive(name: str, default: float, doc: str, unit: str) -> Spec:
     return Spec(name, default, doc, unit=unit, kind="float", low=0.0, low_open=True)
 
 
+def positives(name: str, default: list[float], doc: str, unit: str) -> Spec:
+    """A list of real numbers above zero (the lengths or masses of several bodies)."""
+    return Spec(name, default, doc, unit=unit, kind="floats", low=0.0, low_open=True)
+
+
 def mass(default: float, doc: str) -> Spec:
     """The ``mass`` of the scene's body, in kg."""
     return positive("mass", default, doc, "kg")

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from lawbench.cases import _specs
 from lawbench.cases._chains import (
     ELASTIC_AND_PLASTIC,
     NEWTONS_CRADLE,
@@ -52,14 +53,8 @@ class BallChain(Case):
         Spec(
             "wall", False, "a fixed wall right of the last ball, as the last contact", kind="bool"
         ),
-        Spec(
-            "stiffness",
-            [1.0],
-            "contact stiffness, one value or one per contact",
-            unit="N/m^exponent",
-            kind="floats",
-            low=0.0,
-            low_open=True,
+        _specs.positives(
+            "stiffness", [1.0], "contact stiffness, one value or one per contact", "N/m^exponent"
         ),
         exponent_spec("floats"),
         gaps_spec(1),

@@ -79,24 +79,8 @@ class DoublePendulum(Case):
     name = "double_pendulum"
     summary = "double pendulum striking a rough floor (Kane and Levinson 1985)"
     params = (
-        Spec(
-            "lengths",
-            [1.0, 1.0],
-            "lengths of links 1 and 2",
-            unit="m",
-            kind="floats",
-            low=0.0,
-            low_open=True,
-        ),
-        Spec(
-            "masses",
-            [1.0, 1.0],
-            "masses of links 1 and 2",
-            unit="kg",
-            kind="floats",
-            low=0.0,
-            low_open=True,
-        ),
+        _specs.positives("lengths", [1.0, 1.0], "lengths of links 1 and 2", "m"),
+        _specs.positives("masses", [1.0, 1.0], "masses of links 1 and 2", "kg"),
         Spec(
             "angles",
             [60.0, 45.0],

@@ -552,31 +552,31 @@ def with_mu(problem, mu):
     return ImpactProblem(M=problem.M, Wn=problem.Wn, Wt=problem.Wt, v=problem.v, contacts=contacts)
 
 
-@pytest.mark.parametrize("seed", range(10))
-def test_mu_zero_is_newton_for_one_approaching_contact(seed):
-    """mu = 0 (and mu = 1e-13, through the frictional formulation) gives Newton's law."""
-    problem = random_planar(3000 + seed, 1, mu_high=0.0)
-    if problem.un[0] >= 0:
+WITHOUT_FRICTION = [
+    *((3000 + seed, 1, "newton", "closed form", 1e-13) for seed in range(10)),
+    *((2000 + seed, 2 + seed % 4, "moreau", "Lemke LCP", 1e-12) for seed in range(12)),
+]
+
+
+@pytest.mark.parametrize(("seed", "contacts", "peer", "formulation", "tiny_mu"), WITHOUT_FRICTION)
+def test_mu_zero_is_newton_at_one_contact_and_moreau_at_several(
+    seed, contacts, peer, formulation, tiny_mu
+):
+    """mu = 0 (and a tiny mu, through the frictional formulation) gives Newton's law for one
+    approaching contact, and Moreau's unilateral LCP for several."""
+    problem = random_planar(seed, contacts, mu_high=0.0)
+    if contacts == 1 and problem.un[0] >= 0:
         problem = ImpactProblem(
             M=problem.M, Wn=problem.Wn, Wt=problem.Wt, v=-problem.v, contacts=problem.contacts
         )
-    expected = lawbench.LAWS.get("newton").resolve(problem).v_plus
+    expected = lawbench.LAWS.get(peer).resolve(problem).v_plus
+    atol = 1e-12 if contacts == 1 else 1e-8
     outcome = LAW.resolve(problem)
-    np.testing.assert_allclose(outcome.v_plus, expected, atol=1e-12)
-    assert outcome.diagnostics["formulation"] == "closed form"
-    np.testing.assert_allclose(LAW.resolve(with_mu(problem, 1e-13)).v_plus, expected, atol=1e-10)
-
-
-@pytest.mark.parametrize("seed", range(12))
-def test_mu_zero_is_moreau_for_several_contacts(seed):
-    """Several contacts without friction: moreau's unilateral LCP, also at mu = 1e-12."""
-    moreau = lawbench.LAWS.get("moreau")
-    problem = random_planar(2000 + seed, 2 + seed % 4, mu_high=0.0)
-    expected = moreau.resolve(problem).v_plus
-    outcome = LAW.resolve(problem)
-    np.testing.assert_allclose(outcome.v_plus, expected, atol=1e-8)
-    assert outcome.diagnostics["formulation"] == "Lemke LCP"
-    np.testing.assert_allclose(LAW.resolve(with_mu(problem, 1e-12)).v_plus, expected, atol=1e-8)
+    np.testing.assert_allclose(outcome.v_plus, expected, atol=atol)
+    assert outcome.diagnostics["formulation"] == formulation
+    np.testing.assert_allclose(
+        LAW.resolve(with_mu(problem, tiny_mu)).v_plus, expected, atol=max(atol, 1e-10)
+    )
 
 
 @pytest.mark.parametrize("seed", range(6))

@@ -235,13 +235,8 @@ class FrictionalIntegration(Integration):
                 break
             closed = g <= -self.band
             if not closed.any():
-                # Free flight to the first contact that closes.
-                wait = np.where(un < 0, (g + self.band) / np.where(un < 0, -un, 1.0), np.inf)
-                first = int(np.argmin(wait))
                 spend.event()
-                g += un * wait[first]
-                g[first] = -self.band[first]
-                t += wait[first]
+                t += self._fly_to_contact(g, un)
                 events += 1
                 continue
             # A contact that opened released its spring; one that closes starts by sliding or
@@ -291,6 +286,14 @@ class FrictionalIntegration(Integration):
         return Outcome.from_impulses(
             problem, self.I * P[:m], self.I * P[m:], diagnostics=diagnostics, path=path
         )
+
+    def _fly_to_contact(self, g: np.ndarray, un: np.ndarray) -> float:
+        """Move the gaps ``g`` in free flight until the first contact closes; the time taken."""
+        wait = np.where(un < 0, (g + self.band) / np.where(un < 0, -un, 1.0), np.inf)
+        first = int(np.argmin(wait))
+        g += un * wait[first]
+        g[first] = -self.band[first]
+        return float(wait[first])
 
     def _on_step(self, mode: _Mode, dense: Callable, t_old: float, t: float) -> None:
         """Count the step, keep the peak normal forces (four points) and the path's point."""

@@ -24,16 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lawbench.measurements.impacts import (
-    MEASUREMENTS,
-    MeasuredImpact,
-    MeasurementSet,
-    Processing,
-    Source,
-    planar_problem,
-    processing_from,
-    read_data,
-)
+from lawbench.measurements import impacts as measured
 
 NAME = "kharaz"
 # The quantities digitized, as (incidence key, value key) in the data file.
@@ -44,7 +35,7 @@ QUANTITIES = {
 }
 # The normal restitution of alumina on glass that DEM benchmarks use for this experiment.
 NORMAL_RESTITUTION = 0.98
-SOURCE = Source(
+SOURCE = measured.Source(
     paper=(
         "A. H. Kharaz, D. A. Gorham, A. D. Salman, An experimental study of the elastic "
         "rebound of spheres, Powder Technology 120 (2001) 281-291; points as digitized by "
@@ -99,7 +90,7 @@ class Setup:
 
     def impact(
         self, incidence: float, restitution: float, spin: float, index: int
-    ) -> MeasuredImpact:
+    ) -> measured.MeasuredImpact:
         """The measured impact at ``incidence`` (degrees from the normal).
 
         Rebuilt from the centre's tangential restitution and the rebound spin's magnitude
@@ -110,9 +101,9 @@ class Setup:
         after = np.array([restitution * v[0], -NORMAL_RESTITUTION * v[1], -spin])
         normal = np.array([0.0, 1.0, 0.0])
         tangent = np.array([1.0, 0.0, self.radius])
-        problem = planar_problem(self.mass_matrix(), normal, tangent, v)
+        problem = measured.planar_problem(self.mass_matrix(), normal, tangent, v)
         facts = {"incidence_deg": incidence, "normal_restitution": NORMAL_RESTITUTION}
-        return MeasuredImpact(problem, after, None, NAME, index, facts)
+        return measured.MeasuredImpact(problem, after, None, NAME, index, facts)
 
 
 SETUP = Setup()
@@ -120,12 +111,12 @@ SETUP = Setup()
 
 def curves() -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """The digitized points per quantity: ``(incidence in degrees, value)``."""
-    data = read_data(NAME)
+    data = measured.read_data(NAME)
     return {name: (data[x], data[y]) for name, (x, y) in QUANTITIES.items()}
 
 
-def _load() -> tuple[list[MeasuredImpact], np.ndarray, Processing]:
-    data = read_data(NAME)
+def _load() -> tuple[list[measured.MeasuredImpact], np.ndarray, measured.Processing]:
+    data = measured.read_data(NAME)
     low, high = data["incidence_spin"][0], data["incidence_spin"][-1]
     impacts = []
     for rank, (incidence, restitution) in enumerate(
@@ -134,11 +125,11 @@ def _load() -> tuple[list[MeasuredImpact], np.ndarray, Processing]:
         if low <= incidence <= high:
             spin = float(np.interp(incidence, data["incidence_spin"], data["spin"]))
             impacts.append(SETUP.impact(float(incidence), float(restitution), spin, rank))
-    return impacts, data["train"], processing_from(data)
+    return impacts, data["train"], measured.processing_from(data)
 
 
-KHARAZ = MEASUREMENTS.register(
-    MeasurementSet(
+KHARAZ = measured.MEASUREMENTS.register(
+    measured.MeasurementSet(
         NAME,
         "oblique impacts of a 5 mm alumina sphere on glass at 3.9 m/s, digitized curves",
         SOURCE,
