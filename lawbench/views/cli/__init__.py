@@ -22,6 +22,7 @@ from lawbench.views.cli import (
     export,
     fit,
     listing,
+    measurements,
     regress,
     report,
     run,
@@ -32,7 +33,20 @@ from lawbench.views.cli.common import EXIT_CODES, _Parser, _Version
 
 # The subcommands in the order ``lawbench --help`` lists them. Each module holds its command's
 # ``COMMAND`` (its name and parser settings), ``arguments`` and ``run``.
-COMMANDS = (listing, describe, solve, export, report, study, run, regress, check, fit, bench)
+COMMANDS = (
+    listing,
+    describe,
+    solve,
+    export,
+    report,
+    study,
+    run,
+    regress,
+    check,
+    fit,
+    bench,
+    measurements,
+)
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
