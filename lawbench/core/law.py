@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import time
 import warnings
 from abc import ABC, abstractmethod
@@ -359,7 +360,8 @@ class _Watch:
 def _refuse_non_finite(name: str, **fields: Any) -> None:
     """Raise `SolverFailure` naming the first of ``fields`` that holds a non-finite number."""
     for field, value in fields.items():
-        if not all_finite(np.asarray(value, dtype=float)):
+        finite = math.isfinite(value) if isinstance(value, float) else all_finite(value)
+        if not finite:
             raise SolverFailure(f"{name}: non-finite {field} {value}")
 
 
