@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.files.fclib import fclib_diagnostics, read_fclib, write_fclib
+from lawbench.files.fclib import read_fclib, write_fclib
+from lawbench.files.problem_files import read_problem
 
 h5py = pytest.importorskip("h5py")
 
@@ -200,7 +201,7 @@ def test_global_problems_from_siconos_and_lmgc90_are_solved_on_their_own_data(pa
         residual.append(rj - coulomb_projection(rj - shifted, mu[j]))
     scale = max(np.abs(r).max(), np.abs(u).max())
     assert np.abs(residual).max() <= 1e-8 * scale
-    assert fclib_diagnostics(path, outcome)["fc3d_error"] <= 1e-8
+    assert read_problem(path).facts.diagnostics(outcome)["fc3d_error"] <= 1e-8
 
 
 # Granular problems take thousands of Gauss-Seidel sweeps, above Moreau's default bound.
@@ -303,7 +304,7 @@ def test_a_global_file_held_sparse_gives_the_dense_answer(monkeypatch):
     held_dense = moreau.resolve(dense, method="nsgs", tol=1e-10)
     scale = np.abs(held_dense.Pn).max()
     np.testing.assert_allclose(held_sparse.Pn, held_dense.Pn, rtol=0, atol=1e-8 * scale)
-    assert fclib_diagnostics(path, held_sparse)["fc3d_error"] <= 1e-10
+    assert read_problem(path).facts.diagnostics(held_sparse)["fc3d_error"] <= 1e-10
 
 
 @pytest.mark.parametrize("method", ["nsgs", "fixed_point"])

@@ -18,7 +18,8 @@ import lawbench
 from lawbench.core.budget import Budget
 from lawbench.core.case import CASES
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, SolverFailure
-from lawbench.files.fclib import fclib_diagnostics, read_fclib
+from lawbench.files.fclib import read_fclib
+from lawbench.files.problem_files import read_problem
 from lawbench.numerics.gauss_seidel import error_of, in_local_order, solve_nsgs
 
 pytest.importorskip("h5py")
@@ -92,7 +93,7 @@ def test_nsgs_solves_the_committed_fclib_files(path):
         error = answer.fc3d_error
     else:
         answer = MOREAU.resolve(problem, method="nsgs", tol=1e-8, max_steps=GRANULAR_SWEEPS)
-        error = fclib_diagnostics(path, answer)["fc3d_error"]
+        error = read_problem(path).facts.diagnostics(answer)["fc3d_error"]
     assert error <= 1e-8
     assert answer.diagnostics["formulation"].startswith("NSGS")
     assert answer.diagnostics["sweeps"] >= 1

@@ -27,6 +27,7 @@ from lawbench.core.law import LAWS
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import make_trial
+from lawbench.files.facts import ProblemFile
 from lawbench.studies.guard import TIME_OUT, Guard, Result
 
 # The extensions of the problem files read (`lawbench.files.problem_files.load_problem`).
@@ -88,11 +89,11 @@ def status_of(error: BaseException) -> str:
 
 
 @functools.lru_cache(maxsize=1)
-def _loaded(path: str) -> ImpactProblem | ContactProblem:
-    """The problem of ``path``, read once per worker for all the laws solved on it."""
-    from lawbench.files.problem_files import load_problem
+def _loaded(path: str) -> ProblemFile:
+    """The file ``path`` as read, once per worker for all the laws solved on it."""
+    from lawbench.files.problem_files import read_problem
 
-    return load_problem(path)
+    return read_problem(path)
 
 
 @functools.cache
@@ -116,12 +117,11 @@ def solve_file(
     time alone decides. A local FCLIB file is solved in contact space (`Law.solve_contact`),
     any other problem as an impact. Never raises: a failure is the row's status and error.
     """
-    from lawbench.files.problem_files import file_diagnostics
-
     row: dict[str, Any] = dict.fromkeys(COLUMNS, math.nan)
     row.update(file=Path(path).name, law=law, method=method, status="ok", error="")
     try:
-        problem = _loaded(path)
+        read = _loaded(path)
+        problem = read.problem
         row["contacts"] = problem.m
         _warmed(law, method)
         with alarm(seconds):
@@ -133,7 +133,7 @@ def solve_file(
         if isinstance(answer, ContactSolution):
             row["fc3d_error"] = answer.fc3d_error
         else:
-            row["fc3d_error"] = file_diagnostics(path, answer).get("fc3d_error", math.nan)
+            row["fc3d_error"] = read.facts.diagnostics(answer).get("fc3d_error", math.nan)
     except Exception as exc:  # a row records its failure and the bench goes on
         row["status"], row["error"] = status_of(exc), f"{type(exc).__name__}: {exc}"
     return row

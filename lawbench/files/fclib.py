@@ -45,7 +45,6 @@ import scipy.sparse.linalg
 from lawbench.core.arrays import as_array
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, LawbenchError, LossyExport, NotApplicable
-from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.files.facts import LAYOUTS, ContactSpace, FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py
@@ -361,11 +360,6 @@ def _held(matrix: scipy.sparse.csr_matrix) -> Any:
     """
     m, n = matrix.shape
     return matrix.toarray() if m * n <= DENSE_ENTRIES else scipy.sparse.csc_array(matrix)
-
-
-def fclib_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
-    """How ``outcome`` answers the global FCLIB problem of ``path`` (`FileFacts.diagnostics`)."""
-    return read_fclib_file(path).facts.diagnostics(outcome)
 
 
 def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -> Path:

@@ -43,7 +43,6 @@ import scipy.sparse
 from lawbench.core.arrays import is_sparse
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, LawbenchError
-from lawbench.core.outcome import Outcome
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.files.facts import FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py
@@ -198,21 +197,6 @@ def read_problem(path: str | Path) -> ProblemFile:
         # error an NPZ member that does not inflate.
         raise InvalidProblem(f"{path}: not a lawbench problem file ({exc})") from None
     return read.interpret()
-
-
-def file_diagnostics(path: str | Path, outcome: Outcome) -> dict[str, float]:
-    """What the problem file ``path``'s own data say of ``outcome`` (`FileFacts.diagnostics`).
-
-    Only an FCLIB file has something to say, and it is read again for it: a caller that has
-    read the file already takes them from its `read_problem` facts instead. Lawbench's own
-    formats hold the problem exactly as it is solved, and are not opened.
-    """
-    path = Path(path)
-    if _codec(path)[1] is not _read_hdf5:
-        return {}
-    from lawbench.files.fclib import fclib_diagnostics, fclib_form
-
-    return fclib_diagnostics(path, outcome) if fclib_form(path) else {}
 
 
 @dataclass(frozen=True)
