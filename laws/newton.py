@@ -22,7 +22,7 @@ import numpy as np
 from lawbench.checks.regions import resting_contact, separating_contact
 from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
-from lawbench.core.mechanics import is_diagonal
+from lawbench.core.metric import is_diagonal
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags

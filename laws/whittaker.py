@@ -79,7 +79,7 @@ import scipy.optimize
 
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
-from lawbench.core.mechanics import is_diagonal, kinetic_energy
+from lawbench.core.metric import is_diagonal, kinetic_energy
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags

@@ -9,7 +9,7 @@ import pytest
 
 import lawbench
 from lawbench import Contact, ImpactProblem, InvalidProblem, NotApplicable
-from lawbench.core.mechanics import generalized_impulse
+from lawbench.core.outcome import generalized_impulse
 
 BRACH = lawbench.LAWS.get("brach")
 

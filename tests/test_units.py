@@ -50,9 +50,7 @@ def pairs():
         problem = lawbench.CASES.get(scene).build()
         for name in SCALED_LAWS:
             law = lawbench.LAWS.get(name)
-            if law.tags.covers(lawbench.CASES.get(scene).requires) and not law.tags.refusal(
-                problem
-            ):
+            if law.tags.covers(lawbench.CASES.get(scene).requires) and not law.refusal(problem):
                 yield name, scene
 
 

@@ -6,7 +6,7 @@ import numpy as np
 
 from lawbench.checks.base import TOLERANCE, check
 from lawbench.core.arrays import is_sparse
-from lawbench.core.mechanics import gap_rates
+from lawbench.core.outcome import gap_rates
 from lawbench.core.problem import RESTITUTION_FIELDS
 from lawbench.core.trial import Trial
 

@@ -98,6 +98,17 @@ class Law(ABC):
         """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
         return self.separating_rule
 
+    def refusal(self, problem: ImpactProblem) -> str | None:
+        """Why this law cannot treat ``problem`` (a feature its tags do not cover), or None."""
+        tags = self.tags
+        if problem.frictional and not tags.friction:
+            return "the problem has friction (mu > 0) and this law is frictionless"
+        if problem.d == 2 and problem.frictional and not tags.spatial:
+            return "the problem is spatial (two tangential directions) and this law is planar"
+        if problem.closed_count > 1 and not tags.several_contacts:
+            return f"the problem has {problem.closed_count} closed contacts and this law treats one"
+        return None
+
     def option_values(self, given: dict[str, Any] | None = None) -> dict[str, Any]:
         """Return every option of this law, defaults filled in, checked and converted.
 
@@ -153,7 +164,7 @@ class Law(ABC):
         if not isinstance(problem, ImpactProblem):
             raise TypeError(f"problem must be an ImpactProblem, not {type(problem).__name__}")
         values = self.option_values(options)
-        reason = self.tags.refusal(problem)
+        reason = self.refusal(problem)
         if reason:
             raise NotApplicable(f"{self.name}: {reason}")
         problem, negligible = _without_negligible_friction(problem)

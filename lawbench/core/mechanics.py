@@ -1,4 +1,4 @@
-"""Shared mechanics at a frozen configuration: energy, impulses, gap rates, Coulomb cones."""
+"""Shared mechanics at a frozen configuration: energy shares, kinetic angles, Coulomb cones."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from lawbench.core.arrays import as_array
-from lawbench.core.metric import SPARSE_SHARE, has_off_diagonal, kinetic_energy
+from lawbench.core.metric import SPARSE_SHARE, kinetic_energy
 from lawbench.core.problem import ImpactProblem
 
 if TYPE_CHECKING:
@@ -18,36 +18,9 @@ if TYPE_CHECKING:
 SPARSE_PRODUCTS = 200
 
 
-def generalized_impulse(
-    problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
-) -> np.ndarray:
-    """Return the generalized impulse ``Wn @ Pn + Wt @ Pt`` (Pt None or empty: no friction)."""
-    impulse = problem.Wn.dot(Pn)
-    if Pt is not None and np.size(Pt):
-        impulse = impulse + problem.Wt.dot(Pt)
-    return impulse
-
-
-def velocity_after(
-    problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
-) -> np.ndarray:
-    """Return ``v + M^-1 (Wn @ Pn + Wt @ Pt)``, the velocity after the impulses."""
-    return problem.v + problem.solve_mass(generalized_impulse(problem, Pn, Pt))
-
-
-def gap_rates(problem: ImpactProblem, v: np.ndarray) -> np.ndarray:
-    """Return the normal gap rates ``Wn.T @ v`` of every contact at velocity ``v``."""
-    return problem.Wn.T @ v
-
-
 def separating_contacts(problem: ImpactProblem) -> list[int]:
     """Closed contacts whose gap rate is positive before the impact (they separate)."""
     return list(problem.separating)
-
-
-def is_diagonal(G: np.ndarray) -> bool:
-    """Whether the Delassus matrix (dense or sparse) decouples the contacts."""
-    return not has_off_diagonal(G)
 
 
 def kinetic_angles(problem: ImpactProblem) -> np.ndarray:

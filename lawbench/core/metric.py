@@ -40,6 +40,11 @@ def has_off_diagonal(M: Any) -> bool:
     return bool(np.any(coo.data[coo.row != coo.col]))
 
 
+def is_diagonal(G: np.ndarray) -> bool:
+    """Whether the Delassus matrix (dense or sparse) decouples the contacts."""
+    return not has_off_diagonal(G)
+
+
 def _cho_solve(factor: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """``M^-1 rhs`` from M's lower Cholesky factor.
 

@@ -1,4 +1,7 @@
-"""The result every law returns, with the same fields for all of them."""
+"""The result every law returns, with the same fields for all of them.
+
+Also the kinematics of an answer: the velocity that impulses give, and the gap rates at it.
+"""
 
 from __future__ import annotations
 
@@ -7,11 +10,32 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.core.mechanics import velocity_after
 from lawbench.core.problem import ImpactProblem
 
 if TYPE_CHECKING:
     import pandas as pd
+
+
+def generalized_impulse(
+    problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
+) -> np.ndarray:
+    """Return the generalized impulse ``Wn @ Pn + Wt @ Pt`` (Pt None or empty: no friction)."""
+    impulse = problem.Wn.dot(Pn)
+    if Pt is not None and np.size(Pt):
+        impulse = impulse + problem.Wt.dot(Pt)
+    return impulse
+
+
+def velocity_after(
+    problem: ImpactProblem, Pn: np.ndarray, Pt: np.ndarray | None = None
+) -> np.ndarray:
+    """Return ``v + M^-1 (Wn @ Pn + Wt @ Pt)``, the velocity after the impulses."""
+    return problem.v + problem.solve_mass(generalized_impulse(problem, Pn, Pt))
+
+
+def gap_rates(problem: ImpactProblem, v: np.ndarray) -> np.ndarray:
+    """Return the normal gap rates ``Wn.T @ v`` of every contact at velocity ``v``."""
+    return problem.Wn.T @ v
 
 
 # The tangential impulse of a frictionless outcome: empty, shared, read-only.

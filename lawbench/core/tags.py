@@ -3,16 +3,13 @@
 A law's tags say which features of a problem it treats (friction, several contacts, spatial
 contacts), whether it reads contact stiffness, and which option is its accuracy knob. A scene's
 tags say which of those features its problems have. A law can be given a scene when its tags
-cover the scene's (`Tags.missing` is empty), and a problem when `Tags.refusal` is None.
+cover the scene's (`Tags.missing` is empty), and a problem when `Law.refusal` finds no reason
+in the problem (`lawbench.core.law`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from lawbench.core.problem import ImpactProblem
 
 # The features a scene can require and a law can treat, with their words for messages.
 FEATURES = {
@@ -57,13 +54,3 @@ class Tags:
     def covers(self, required: Tags) -> bool:
         """Whether a law with these tags treats every feature ``required`` names."""
         return not self.missing(required)
-
-    def refusal(self, problem: ImpactProblem) -> str | None:
-        """Why a law with these tags cannot treat ``problem``, or None."""
-        if problem.frictional and not self.friction:
-            return "the problem has friction (mu > 0) and this law is frictionless"
-        if problem.d == 2 and problem.frictional and not self.spatial:
-            return "the problem is spatial (two tangential directions) and this law is planar"
-        if problem.closed_count > 1 and not self.several_contacts:
-            return f"the problem has {problem.closed_count} closed contacts and this law treats one"
-        return None

@@ -33,8 +33,7 @@ import scipy.sparse.linalg
 from lawbench.core import budget
 from lawbench.core.arrays import as_array, is_sparse
 from lawbench.core.errors import SolverFailure
-from lawbench.core.mechanics import is_diagonal
-from lawbench.core.metric import SPARSE_SHARE
+from lawbench.core.metric import SPARSE_SHARE, is_diagonal
 
 ROUNDING = 1e-12
 # Contacts up to which active-set enumeration (2**m sets) is the exact, cheap method.

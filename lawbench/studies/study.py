@@ -238,7 +238,7 @@ class Study:
             return LAWS.names()
         if self.laws == "able":
             problem = case.build(**self.params)
-            return [law.name for law in LAWS.values() if law.tags.refusal(problem) is None]
+            return [law.name for law in LAWS.values() if law.refusal(problem) is None]
         return [law.name for law in LAWS.values() if law.tags.covers(case.requires)]
 
     def preset(self, mode: str) -> Study:

@@ -65,7 +65,7 @@ import numpy as np
 
 from lawbench.checks.regions import nonlinear_springs
 from lawbench.core.law import LAWS, Law
-from lawbench.core.mechanics import is_diagonal
+from lawbench.core.metric import is_diagonal
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec

@@ -113,7 +113,7 @@ import numpy as np
 import scipy.special
 
 from lawbench.core.law import LAWS, Law
-from lawbench.core.mechanics import is_diagonal
+from lawbench.core.metric import is_diagonal
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec

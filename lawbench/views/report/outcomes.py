@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from lawbench.core.case import Case, Reference
-from lawbench.core.mechanics import kinetic_energy
+from lawbench.core.metric import kinetic_energy
 from lawbench.views.report import plots
 from lawbench.views.report.page import Figure, Section, Table, number
 from lawbench.views.report.runs import Context, parsed, vector
