@@ -7,7 +7,7 @@ import argparse
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
 from lawbench.files.paths import output_file
-from lawbench.views.cli.common import _names, _path, _seconds, _tolerance
+from lawbench.views.cli.main import _names, _path, _seconds, _tolerance
 
 # Seconds one law may spend on one file of ``lawbench bench --problems``.
 PROBLEM_BUDGET_S = 60.0

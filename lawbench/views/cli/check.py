@@ -8,7 +8,7 @@ import sys
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS, Law
-from lawbench.views.cli.common import MAX_REPEATS, CheckFailed, _count, _names
+from lawbench.views.cli.main import MAX_REPEATS, CheckFailed, _count, _names
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = (

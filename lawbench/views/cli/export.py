@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from lawbench.core.case import CASES
-from lawbench.views.cli.common import _assignments, _path, add_assignments
+from lawbench.views.cli.main import _assignments, _path, add_assignments
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = ("export", {"help": "write a scene's problem to a file"})

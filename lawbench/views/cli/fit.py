@@ -6,7 +6,7 @@ import argparse
 import json
 
 from lawbench.core.errors import InvalidProblem
-from lawbench.views.cli.common import (
+from lawbench.views.cli.main import (
     MAX_REPEATS,
     _assignments,
     _count,

@@ -6,7 +6,7 @@ import argparse
 
 from lawbench.core.case import CASES
 from lawbench.core.law import LAWS
-from lawbench.views.cli.common import Drift, _names
+from lawbench.views.cli.main import Drift, _names
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = ("regress", {"help": "compare every law with its baseline"})

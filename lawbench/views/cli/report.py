@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from lawbench.files.paths import output_folder
-from lawbench.views.cli.common import _path
+from lawbench.views.cli.main import _path
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = ("report", {"help": "write the comparison report"})

@@ -10,7 +10,7 @@ from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
 from lawbench.files.paths import output_file
-from lawbench.views.cli.common import (
+from lawbench.views.cli.main import (
     MAX_REPEATS,
     _assignments,
     _count,

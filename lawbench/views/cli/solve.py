@@ -15,7 +15,7 @@ from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.trial import Trial, make_trial
 from lawbench.files.facts import ProblemFile
-from lawbench.views.cli.common import _assignments, _path, _seconds, add_assignments
+from lawbench.views.cli.main import _assignments, _path, _seconds, add_assignments
 
 # Contacts whose impulses the text output of a contact-space solve lists (--json gives all).
 SHOWN_CONTACTS = 10

@@ -8,7 +8,7 @@ from pathlib import Path
 from lawbench.core.errors import InvalidProblem
 from lawbench.files.paths import output_file
 from lawbench.studies.declared import STUDIES
-from lawbench.views.cli.common import _assignments, _executor_arguments, _path, add_assignments
+from lawbench.views.cli.main import _assignments, _executor_arguments, _path, add_assignments
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = (

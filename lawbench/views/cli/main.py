@@ -1,13 +1,22 @@
-"""What the commands of ``lawbench`` share: the parser, argument types, options and errors."""
+"""The ``lawbench`` command line: its parser and dispatch, and what the commands share.
+
+Argument types, options and errors are shared by the commands, one module each in this
+package; their exit codes are in the package's docstring.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import logging
+import sys
+import warnings
 from collections.abc import Callable, Sequence
 
 from lawbench.core.errors import (
     InvalidProblem,
     LawbenchError,
+    LossyExport,
     NotApplicable,
     SolverFailure,
 )
@@ -160,3 +169,90 @@ def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
         default=BUDGET_S,
         help=f"wall-clock guard of one cell, in seconds (default {BUDGET_S:g})",
     )
+
+
+# The subcommands in the order ``lawbench --help`` lists them. Each module holds its command's
+# ``COMMAND`` (its name and parser settings), ``arguments`` and ``run``; the names are the
+# modules' in this package.
+COMMANDS = (
+    "listing",
+    "describe",
+    "solve",
+    "export",
+    "report",
+    "study",
+    "run",
+    "regress",
+    "check",
+    "fit",
+    "bench",
+    "measurements",
+)
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the ``lawbench`` command.
+
+    Every subcommand is listed; only ``command`` is given its arguments (every one when None),
+    so that a command's run reads no other command's module.
+    """
+    parser = _Parser(prog="lawbench", description="Compare impact laws on shared scenes.")
+    parser.add_argument("--version", action=_Version, help="print the version and exit")
+    parser.add_argument(
+        "--verbose",
+        action="store_true",
+        help="print the warnings of the numerical libraries (a solve keeps its own in its "
+        "diagnostics)",
+    )
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for module_name in COMMANDS:
+        # Imported when the parser is built: the command modules import this one's helpers.
+        module = importlib.import_module(f"{__package__}.{module_name}")
+        name, settings = module.COMMAND
+        subparser = commands.add_parser(name, **settings)
+        if command is None or command in (name, *settings.get("aliases", ())):
+            module.arguments(subparser)
+    return parser
+
+
+def _command(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` names: its first word that is not an option, if any."""
+    return next((word for word in argv if not word.startswith("-")), None)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit code."""
+    # The run machinery reports damaged chunks through logging: one line on stderr each.
+    logging.basicConfig(format="lawbench: %(message)s", level=logging.WARNING)
+    try:
+        argv = sys.argv[1:] if argv is None else list(argv)
+        args = build_parser(_command(argv)).parse_args(argv)
+    except SystemExit as exit_:  # usage errors and --help
+        return int(exit_.code or 0)
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            args.run(args)
+        # What an export leaves out is always said; a library's warnings only when asked for.
+        for warning in caught:
+            if args.verbose or issubclass(warning.category, LossyExport):
+                print(f"lawbench: warning: {warning.message}", file=sys.stderr)
+    except LawbenchError as exc:
+        print(f"lawbench: {_one_line(exc)}", file=sys.stderr)
+        return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
+    except BrokenPipeError:
+        return 0
+    except KeyboardInterrupt:
+        print(
+            "lawbench: interrupted; finished rows are kept (rerun with --resume)", file=sys.stderr
+        )
+        return 130
+    except Exception as exc:  # a bug: still one line, never a traceback
+        print(f"lawbench: internal error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _one_line(message: object) -> str:
+    """``message`` on one line: a library's message or a path may hold line breaks."""
+    return " ".join(line.strip() for line in str(message).splitlines() if line.strip())
