@@ -22,22 +22,20 @@ from lawbench.cases._chains import (
     NEWTONS_CRADLE,
     PLASTIC_CHAIN,
     SPRINGS,
+    ball_velocities,
+    chain_problem,
+    exponent_spec,
+    gaps_spec,
     masses_extremes,
+    masses_spec,
+    restitution_spec,
+    velocities_spec,
 )
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
-from lawbench.numerics.chains import (
-    ball_velocities,
-    chain_problem,
-    exponent_spec,
-    gaps_spec,
-    masses_spec,
-    restitution_spec,
-    velocities_spec,
-)
 
 
 class BallChain(Case):

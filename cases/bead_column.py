@@ -24,12 +24,11 @@ import math
 from typing import Any
 
 from lawbench.cases import _specs
-from lawbench.cases._chains import SPRINGS
+from lawbench.cases._chains import SPRINGS, ball_velocities, chain_problem, restitution_spec
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
-from lawbench.numerics.chains import ball_velocities, chain_problem, restitution_spec
 
 BEAD_MASS = 2.05e-3
 BEAD_STIFFNESS = 6.9716e9

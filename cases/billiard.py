@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.cases import _specs
+from lawbench.cases._chains import exponent_spec, stiffness_ratio_spec
 from lawbench.cases._friction import springs_with_friction
 from lawbench.core.case import CASES, Case, Params, Reference, per_item
 from lawbench.core.errors import InvalidProblem
@@ -48,7 +49,6 @@ from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.core.trial import Trial
-from lawbench.numerics.chains import exponent_spec, stiffness_ratio_spec
 from lawbench.numerics.rigid import spatial_column
 
 TABLE_NORMAL = np.array([0.0, 0.0, 1.0])

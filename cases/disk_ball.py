@@ -50,13 +50,13 @@ from typing import Any
 import numpy as np
 
 from lawbench.cases import _specs
+from lawbench.cases._chains import exponent_spec, stiffness_ratio_spec
 from lawbench.cases._friction import springs_with_friction
 from lawbench.core.case import CASES, Case, Params, per_item
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
-from lawbench.numerics.chains import exponent_spec, stiffness_ratio_spec
 
 CONTACTS = ("A", "B", "C", "D")
 

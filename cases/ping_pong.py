@@ -45,10 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.cases.two_balls_wall import TwoBallsWall
-from lawbench.core.case import CASES, Params
-from lawbench.core.spec import Spec
-from lawbench.numerics.chains import (
+from lawbench.cases._chains import (
     ball_velocities,
     exponent_spec,
     gaps_spec,
@@ -56,6 +53,9 @@ from lawbench.numerics.chains import (
     stiffness_ratio_spec,
     velocities_spec,
 )
+from lawbench.cases.two_balls_wall import TwoBallsWall
+from lawbench.core.case import CASES, Params
+from lawbench.core.spec import Spec
 
 # Jia, Mason, Erdmann (2013) as in Jia's 2012 talk: measured ball-ball and ball-table
 # coefficients, and the stiffness ratio k2/k1 they guessed.

@@ -16,12 +16,12 @@ from lawbench.cases._chains import (
     PLASTIC_CHAIN,
     SPRINGS,
     TwoContactChain,
+    ball_velocities,
     masses_extremes,
     two_contact_studies,
 )
 from lawbench.core.case import CASES, Params, Reference
 from lawbench.core.tags import Tags
-from lawbench.numerics.chains import ball_velocities
 
 
 def _equation_29(p: Params) -> np.ndarray:

@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from lawbench.cases._chains import SPRINGS, TwoContactChain, two_contact_studies
+from lawbench.cases._chains import SPRINGS, TwoContactChain, ball_velocities, two_contact_studies
 from lawbench.core.case import CASES, Params, Reference
 from lawbench.core.tags import Tags
-from lawbench.numerics.chains import ball_velocities
 
 
 def _unpack(p: Params) -> tuple[float, float, float, float, float]:

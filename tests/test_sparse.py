@@ -6,9 +6,9 @@ import scipy.sparse
 
 import lawbench
 from lawbench import Contact, ImpactProblem, InvalidProblem
+from lawbench.cases._chains import SPARSE_CONTACTS
 from lawbench.core.metric import SMALL
 from lawbench.files.problem_files import load_problem, save_problem
-from lawbench.numerics.chains import SPARSE_CONTACTS
 from lawbench.numerics.solvers import _solve_block
 
 

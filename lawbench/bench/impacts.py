@@ -32,13 +32,13 @@ from lawbench.bench.timing import (
     numpy_enumeration,
     row,
 )
+from lawbench.cases._chains import chain_problem
 from lawbench.core.batch import ProblemBatch
 from lawbench.core.case import CASES
 from lawbench.core.errors import SolverFailure
 from lawbench.core.law import LAWS
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import solve, solve_batch
-from lawbench.numerics.chains import chain_problem
 
 # Chain lengths of the full report: the growth from 1,000 to 10,000 balls shows the cost per ball.
 CHAINS = (100, 1000, 10_000)
