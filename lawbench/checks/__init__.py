@@ -13,7 +13,13 @@ runs them by default. ``continuity`` and ``dispersion`` solve the case again and
 """
 
 from lawbench.checks import continuity, dispersion, outcome_checks
-from lawbench.checks.base import CHECKS, SINGLE_SOLVE, CheckResult, CheckResults, run_checks
+from lawbench.checks.outcome_checks import (
+    CHECKS,
+    SINGLE_SOLVE,
+    CheckResult,
+    CheckResults,
+    run_checks,
+)
 
 __all__ = [
     "CHECKS",

@@ -22,8 +22,8 @@ import dataclasses
 
 import numpy as np
 
-from lawbench.checks.base import check
 from lawbench.checks.gaps import resolve_with_gaps
+from lawbench.checks.outcome_checks import check
 from lawbench.core.errors import LawbenchError
 from lawbench.core.mechanics import kinetic_angles
 from lawbench.core.problem import ImpactProblem

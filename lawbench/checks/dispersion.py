@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from lawbench.checks.base import check
+from lawbench.checks.outcome_checks import check
 from lawbench.core.errors import LawbenchError
 from lawbench.core.law import LAWS
 from lawbench.core.mechanics import energy_shares

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import ListedColormap, TwoSlopeNorm
 
-from lawbench.checks.base import TOLERANCE
+from lawbench.checks.outcome_checks import TOLERANCE
 from lawbench.core.case import Case
 from lawbench.core.verdicts import Verdict
 from lawbench.studies.study import Study
