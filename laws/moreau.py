@@ -117,12 +117,11 @@ import scipy.sparse
 
 from lawbench.checks.regions import option, separating_contact
 from lawbench.core import budget
-from lawbench.core.arrays import as_array
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.mechanics import fc3d_error
-from lawbench.core.metric import is_diagonal
+from lawbench.core.metric import as_array, is_diagonal
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec

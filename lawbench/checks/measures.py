@@ -24,10 +24,10 @@ import numpy as np
 from lawbench.checks.continuity import jumps
 from lawbench.checks.dispersion import dispersion_index as _index
 from lawbench.checks.knobs import tightest
-from lawbench.core.arrays import is_sparse
 from lawbench.core.errors import LawbenchError
 from lawbench.core.law import LAWS
 from lawbench.core.mechanics import energy_shares as _shares
+from lawbench.core.metric import is_sparse
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import Trial
 

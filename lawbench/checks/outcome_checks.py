@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.core.arrays import is_sparse
 from lawbench.core.case import Case
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import Law
+from lawbench.core.metric import is_sparse
 from lawbench.core.outcome import gap_rates
 from lawbench.core.problem import RESTITUTION_FIELDS, ImpactProblem
 from lawbench.core.trial import Trial, evaluate

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core.arrays import is_sparse
 from lawbench.core.mechanics import kinetic_angles, separating_contacts
+from lawbench.core.metric import is_sparse
 from lawbench.core.verdicts import EVERYWHERE, Region
 
 # Relative size of a normal-tangential Delassus entry that counts as coupling.

@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.core.arrays import all_finite
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.metric import all_finite
 from lawbench.core.problem import RESTITUTION_FIELDS, Contact, ImpactProblem
 from lawbench.core.units import UNIT_BAND
 

@@ -28,9 +28,9 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from lawbench.core import budget
-from lawbench.core.arrays import all_finite
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.metric import all_finite
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.registry import Registry

@@ -6,8 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lawbench.core.arrays import as_array
-from lawbench.core.metric import SPARSE_SHARE, kinetic_energy
+from lawbench.core.metric import SPARSE_SHARE, as_array, kinetic_energy
 from lawbench.core.problem import ImpactProblem
 
 if TYPE_CHECKING:

@@ -22,9 +22,16 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core.arrays import checked_matrix, checked_sparse_matrix, is_sparse, read_only_finite
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.metric import SMALL, KineticMetric, kinetic_energy
+from lawbench.core.metric import (
+    SMALL,
+    KineticMetric,
+    checked_matrix,
+    checked_sparse_matrix,
+    is_sparse,
+    kinetic_energy,
+    read_only_finite,
+)
 from lawbench.core.units import solving_units, stiffness_in_units
 
 # The kinds of restitution coefficient and the contact field that overrides ``e`` for each:

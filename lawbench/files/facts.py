@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core.arrays import as_array
 from lawbench.core.contact import ContactProblem
 from lawbench.core.mechanics import fc3d_error
+from lawbench.core.metric import as_array
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 

@@ -42,9 +42,9 @@ import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
-from lawbench.core.arrays import as_array
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, LawbenchError, LossyExport, NotApplicable
+from lawbench.core.metric import as_array
 from lawbench.core.problem import ImpactProblem
 from lawbench.files.facts import LAYOUTS, ContactSpace, FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py

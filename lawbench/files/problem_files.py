@@ -40,9 +40,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import scipy.sparse
 
-from lawbench.core.arrays import is_sparse
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, LawbenchError
+from lawbench.core.metric import is_sparse
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.files.facts import FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py

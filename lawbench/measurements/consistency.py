@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lawbench.core.arrays import as_array
+from lawbench.core.metric import as_array
 from lawbench.measurements.impacts import MeasuredImpact
 
 # A residual above this share of |M dv| counts as inconsistent in `consistency`.

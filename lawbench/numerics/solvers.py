@@ -31,9 +31,8 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from lawbench.core import budget
-from lawbench.core.arrays import as_array, is_sparse
 from lawbench.core.errors import SolverFailure
-from lawbench.core.metric import SPARSE_SHARE, is_diagonal
+from lawbench.core.metric import SPARSE_SHARE, as_array, is_diagonal, is_sparse
 
 ROUNDING = 1e-12
 # Contacts up to which active-set enumeration (2**m sets) is the exact, cheap method.

@@ -68,9 +68,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from lawbench.core.arrays import all_finite
 from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
+from lawbench.core.metric import all_finite
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
