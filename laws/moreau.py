@@ -116,10 +116,9 @@ import numpy as np
 import scipy.sparse
 
 from lawbench.checks.regions import option, separating_contact
-from lawbench.core import budget
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
-from lawbench.core.law import LAWS, Law
+from lawbench.core.law import LAWS, Law, current_budget
 from lawbench.core.mechanics import fc3d_error
 from lawbench.core.metric import as_array, is_diagonal
 from lawbench.core.outcome import Outcome
@@ -409,7 +408,7 @@ def _fixed_point(
     symmetric = (G + G.T) / 2
     skew = G - symmetric
     shift, steps, iterations, note = np.zeros(q.size), 0, 0, ""
-    spend = budget.current()
+    spend = current_budget()
     while True:
         spend.step("Coulomb fixed-point steps", note)
         result = cones.solve_cone_qp(symmetric, q + shift, mu, d, tol, options["polish"])

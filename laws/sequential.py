@@ -26,8 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core import budget
-from lawbench.core.law import LAWS, Law
+from lawbench.core.law import LAWS, Law, current_budget
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
@@ -105,7 +104,7 @@ class _BinaryImpacts:
 
     def __init__(self, problem: ImpactProblem) -> None:
         self.problem = problem
-        self.spend = budget.current()
+        self.spend = current_budget()
         self.G = problem.delassus
         self.e = problem.restitution("kinematic")
         self.un = problem.un.copy()

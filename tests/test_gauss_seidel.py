@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.core.budget import Budget
 from lawbench.core.case import CASES
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, SolverFailure
+from lawbench.core.law import Budget
 from lawbench.files.fclib import read_fclib
 from lawbench.files.problem_files import read_problem
 from lawbench.numerics.gauss_seidel import error_of, in_local_order, solve_nsgs
@@ -158,7 +158,7 @@ def test_a_sparse_delassus_matrix_gives_the_dense_answer():
 
 def test_the_budget_stops_the_sweeps():
     """A problem that needs tens of sweeps stops at a bound of 5 sweeps, or of 1 ms, with
-    `BudgetExceeded` naming the bound (lawbench.core.budget).
+    `BudgetExceeded` naming the bound (lawbench.core.law.Budget).
     """
     problem = read_fclib(next(path for path in FCLIB if path.stem.startswith("Box_Stacks")))
     with pytest.raises(BudgetExceeded, match="5 Gauss-Seidel sweeps") as raised:

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.core import budget
 from lawbench.core.errors import BudgetExceeded
+from lawbench.core.law import Budget
 from lawbench.numerics.integrator import EventIntegrator
 
 
@@ -105,7 +105,7 @@ def test_no_event_before_the_end_returns_the_end_and_every_step_is_seen():
 def test_the_open_budget_bounds_steps_and_events(limits, option):
     """Steps and events are spent from the budget the solve opened; it names what ran out."""
     integrator = EventIntegrator(rtol=1e-12, atol=1e-14)
-    with budget.Budget("a law", **limits):
+    with Budget("a law", **limits):
         with pytest.raises(BudgetExceeded, match=f"a law: .* budget ran out .*{option}") as info:
             y = np.array([0.0, 1.0])
             for _ in range(10):  # each event is a zero of sin t
@@ -116,7 +116,7 @@ def test_the_open_budget_bounds_steps_and_events(limits, option):
 
 def test_the_time_budget_stops_a_long_integration():
     """An integration that would take long stops at max_seconds, naming it."""
-    with budget.Budget("a law", max_seconds=1e-3):
+    with Budget("a law", max_seconds=1e-3):
         with pytest.raises(BudgetExceeded, match=r"time budget ran out \(0.001 s") as info:
             EventIntegrator(rtol=1e-13, atol=1e-15).to_event(
                 harmonic, 0.0, np.array([0.0, 1.0]), lambda t, y: np.array([1.0]), x_end=1e9

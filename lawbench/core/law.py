@@ -5,8 +5,17 @@ guarantees, and implements `Law._resolve`. `Law.resolve` does what is common to 
 checks the options and the problem against the tags, restricts the problem to its closed contacts
 (a contact with a positive gap is not part of this impact), solves a problem of extreme scale in
 units near it and scales the answer back (`ImpactProblem.units`), times the solve within the
-budget its options set (`lawbench.core.budget`: every law has ``max_seconds``), and refuses to
-return a non-finite answer.
+budget its options set, and refuses to return a non-finite answer.
+
+The budget is what one solve may spend: steps, events and wall-clock seconds, one mechanism for
+every law. `Law.resolve` opens a `Budget` (a context manager) from the law's options for the
+time of the solve: ``max_seconds`` (every law has it), ``max_steps`` (a law that steps:
+integrator steps, fixed-point iterations, binary impacts) and ``max_events`` (a law that
+restarts at events), each when the law declares it. The law's loops spend from
+`current_budget()` (the event integrator of `lawbench.numerics.integrator` does it for the
+integrating laws; an iterative solver calls `Budget.step` once per iteration), and a budget that
+runs out raises `BudgetExceeded` naming the option, its amount and the seconds spent, which is
+what a budget cell of a table shows. `alarm` stops from outside a solve that ignores its own.
 
 A law that also solves Coulomb's frictional contact problem in contact space (FCLIB's local
 form, `lawbench.core.contact.ContactProblem`: no generalized coordinates, only ``W``, ``q`` and
@@ -17,21 +26,25 @@ budget, timing and refusal of non-finite answers. The other laws refuse such a p
 
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 import functools
 import math
+import signal
+import threading
 import time
 import warnings
 from abc import ABC, abstractmethod
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from lawbench.core import budget
 from lawbench.core.contact import ContactProblem, ContactSolution
-from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.metric import all_finite
-from lawbench.core.outcome import Outcome
+from lawbench.core.outcome import Outcome, embedded, scaled_back
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.registry import Registry
 from lawbench.core.spec import Spec
@@ -49,6 +62,143 @@ NEGLIGIBLE_MU = 1e-9
 # The largest dense copy of a sparse problem made for a law that works on dense matrices: the
 # 100000-ball chain's mass matrix alone would take 75 GiB.
 DENSE_BYTES = 2**31
+
+
+MAX_SECONDS = Spec(
+    "max_seconds", 60.0, "wall-clock budget of one solve", unit="s", low=0.0, low_open=True
+)
+
+
+class Budget:
+    """Steps, events and seconds one solve of law ``law`` may spend.
+
+    Parameters
+    ----------
+    law : str
+        The law's name, for the messages.
+    max_seconds : float
+        Wall-clock seconds from now.
+    max_steps, max_events : int or None
+        Counts of steps and of events; None for no bound.
+    """
+
+    def __init__(
+        self,
+        law: str,
+        max_seconds: float = math.inf,
+        max_steps: int | None = None,
+        max_events: int | None = None,
+    ) -> None:
+        self.law, self.max_seconds = law, max_seconds
+        self.max_steps, self.max_events = max_steps, max_events
+        self.steps = self.events = 0
+        self.start = time.monotonic()
+
+    @classmethod
+    def of(cls, law: str, options: Mapping[str, Any]) -> Budget:
+        """The budget a law's checked ``options`` set (the ones it declares)."""
+        return cls(
+            law,
+            options.get("max_seconds", math.inf),
+            options.get("max_steps"),
+            options.get("max_events"),
+        )
+
+    @property
+    def spent_s(self) -> float:
+        """Seconds since the budget was opened."""
+        return time.monotonic() - self.start
+
+    @property
+    def seconds_left(self) -> float:
+        """Seconds left before ``max_seconds`` runs out (never negative)."""
+        return max(self.max_seconds - self.spent_s, 0.0)
+
+    def step(self, what: str = "steps", note: str = "") -> None:
+        """Spend one step and check the time.
+
+        ``what`` names the steps in the message, ``note`` says where the method stood.
+        """
+        self.steps += 1
+        if self.max_steps is not None and self.steps > self.max_steps:
+            where = f"; {note}" if note else ""
+            self._exceeded(f"step budget ran out ({self.max_steps} {what}{where}", "max_steps")
+        self.check_time()
+
+    def event(self, what: str = "events") -> None:
+        """Spend one event and check the time."""
+        self.events += 1
+        if self.max_events is not None and self.events > self.max_events:
+            self._exceeded(f"event budget ran out ({self.max_events} {what}", "max_events")
+        self.check_time()
+
+    def check_time(self) -> None:
+        """Raise once ``max_seconds`` have passed."""
+        if self.spent_s > self.max_seconds:
+            self.out_of_time()
+
+    def out_of_time(self) -> None:
+        """Raise the time budget's `BudgetExceeded` (a solver given `seconds_left` stopped)."""
+        self._exceeded(f"time budget ran out ({self.max_seconds:g} s", "max_seconds")
+
+    def _exceeded(self, what: str, option: str) -> None:
+        amount = {
+            "max_steps": self.max_steps,
+            "max_events": self.max_events,
+            "max_seconds": self.max_seconds,
+        }[option]
+        # The seconds spent go with the error, not into its message: messages are
+        # deterministic, and a table groups its failed cells by message.
+        raise BudgetExceeded(f"{self.law}: {what}, {option})", option, amount, self.spent_s)
+
+    def __enter__(self) -> Budget:
+        """Open the budget: `current` gives it inside the block (blocks nest)."""
+        self._token = _OPEN.set(self)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        _OPEN.reset(self._token)
+
+
+_OPEN: contextvars.ContextVar[Budget | None] = contextvars.ContextVar("budget", default=None)
+
+
+def current_budget() -> Budget:
+    """The budget of the solve under way; an unbounded one outside any solve."""
+    return _OPEN.get() or Budget("lawbench")
+
+
+# The budget that a stop from outside the solve names.
+WALL_CLOCK = "wall-clock guard"
+
+
+def stopped(seconds: float) -> BudgetExceeded:
+    """The error of a job stopped by the guard after ``seconds``."""
+    return BudgetExceeded(
+        f"no answer within {seconds:g} s: stopped by the {WALL_CLOCK}", WALL_CLOCK, seconds, seconds
+    )
+
+
+@contextmanager
+def alarm(seconds: float | None) -> Iterator[None]:
+    """Raise `stopped` inside the enclosed code once ``seconds`` have passed.
+
+    No guard when ``seconds`` is None or outside the main thread (signals reach only it).
+    """
+    if not seconds or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def ring(signum: int, frame: Any) -> None:
+        raise stopped(seconds)
+
+    previous = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 class Law(ABC):
@@ -89,10 +239,10 @@ class Law(ABC):
     scale_free: ClassVar[bool] = True
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
-        """Give every law the wall-clock budget ``max_seconds`` (`lawbench.core.budget`)."""
+        """Give every law the wall-clock budget ``max_seconds`` (`lawbench.core.law`)."""
         super().__init_subclass__(**kwargs)
-        if not any(spec.name == budget.OPTION.name for spec in cls.options):
-            cls.options = (*cls.options, budget.OPTION)
+        if not any(spec.name == MAX_SECONDS.name for spec in cls.options):
+            cls.options = (*cls.options, MAX_SECONDS)
 
     def rule_for_separating(self, options: dict[str, Any]) -> str:
         """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
@@ -189,7 +339,7 @@ class Law(ABC):
         with _Watch(self.name, values) as watch:
             outcome = self._resolve_closed(solved, values)
         if solved is not problem:
-            outcome = _scaled_back(outcome, problem, units)
+            outcome = scaled_back(outcome, problem, units)
         if problem.Wt is not None and outcome.Pt.size == 0:
             outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
         _refuse_non_finite(
@@ -212,7 +362,9 @@ class Law(ABC):
             return self._resolve(problem, options)
         if problem.closed_count:
             closed = problem.closed
-            return _embed(self._resolve(problem.select_contacts(closed), options), closed, problem)
+            return embedded(
+                self._resolve(problem.select_contacts(closed), options), closed, problem
+            )
         outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
         outcome.diagnostics["formulation"] = "no closed contact"
         return outcome
@@ -342,13 +494,13 @@ def _without_negligible_friction(problem: ImpactProblem) -> tuple[ImpactProblem,
 class _Watch:
     """What every solve shares: its budget, its wall time, and the warnings it raised.
 
-    Opened around a law's own solve, it opens the `budget.Budget` the checked ``options`` set
+    Opened around a law's own solve, it opens the `Budget` the checked ``options`` set
     and records every warning instead of printing it. ``record`` then holds ``options``,
     ``wall_time_s`` and, where the solve raised any, ``warnings``, for the answer's diagnostics.
     """
 
     def __init__(self, law: str, options: dict[str, Any]) -> None:
-        self.budget = budget.Budget.of(law, options)
+        self.budget = Budget.of(law, options)
         self.warnings = warnings.catch_warnings(record=True)
         self.record: dict[str, Any] = {"options": options}
 
@@ -374,43 +526,6 @@ def _refuse_non_finite(name: str, **fields: Any) -> None:
         finite = math.isfinite(value) if isinstance(value, float) else all_finite(value)
         if not finite:
             raise SolverFailure(f"{name}: non-finite {field} {value}")
-
-
-def _scaled_back(
-    outcome: Outcome, problem: ImpactProblem, units: tuple[float, float, float]
-) -> Outcome:
-    """The outcome of ``problem`` from one solved in ``units`` of mass, velocity and time.
-
-    Velocities are multiplied by the velocity unit and impulses by the product of both, and
-    the energies are the problem's own. The path and the diagnostics stay in the units solved
-    in, which ``diagnostics['units']`` names.
-    """
-    mass, velocity, time = units
-    diagnostics = {
-        **outcome.diagnostics,
-        "units": {"mass": mass, "velocity": velocity, "time": time},
-    }
-    return Outcome.from_velocity(
-        problem,
-        outcome.v_plus * velocity,
-        outcome.Pn * (mass * velocity),
-        outcome.Pt * (mass * velocity),
-        status=outcome.status,
-        diagnostics=diagnostics,
-        path=outcome.path,
-    )
-
-
-def _embed(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outcome:
-    """Give an outcome solved on the closed contacts the impulses of every contact."""
-    Pn = np.zeros(problem.m)
-    Pn[closed] = outcome.Pn
-    Pt = outcome.Pt
-    if Pt.size and problem.d:
-        Pt = np.zeros((problem.m, problem.d))
-        Pt[closed] = outcome.Pt.reshape(-1, problem.d)
-        Pt = Pt.ravel()
-    return dataclasses.replace(outcome, Pn=Pn, Pt=Pt)
 
 
 LAWS: Registry[Law] = Registry("law", "lawbench.laws", Law)

@@ -5,6 +5,7 @@ Also the kinematics of an answer: the velocity that impulses give, and the gap r
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -140,3 +141,40 @@ class Outcome:
             path,
             problem.v,
         )
+
+
+def scaled_back(
+    outcome: Outcome, problem: ImpactProblem, units: tuple[float, float, float]
+) -> Outcome:
+    """The outcome of ``problem`` from one solved in ``units`` of mass, velocity and time.
+
+    Velocities are multiplied by the velocity unit and impulses by the product of both, and
+    the energies are the problem's own. The path and the diagnostics stay in the units solved
+    in, which ``diagnostics['units']`` names.
+    """
+    mass, velocity, time = units
+    diagnostics = {
+        **outcome.diagnostics,
+        "units": {"mass": mass, "velocity": velocity, "time": time},
+    }
+    return Outcome.from_velocity(
+        problem,
+        outcome.v_plus * velocity,
+        outcome.Pn * (mass * velocity),
+        outcome.Pt * (mass * velocity),
+        status=outcome.status,
+        diagnostics=diagnostics,
+        path=outcome.path,
+    )
+
+
+def embedded(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outcome:
+    """Give an outcome solved on the closed contacts the impulses of every contact."""
+    Pn = np.zeros(problem.m)
+    Pn[closed] = outcome.Pn
+    Pt = outcome.Pt
+    if Pt.size and problem.d:
+        Pt = np.zeros((problem.m, problem.d))
+        Pt[closed] = outcome.Pt.reshape(-1, problem.d)
+        Pt = Pt.ravel()
+    return dataclasses.replace(outcome, Pn=Pn, Pt=Pt)

@@ -15,11 +15,10 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
-from lawbench.core.budget import alarm
 from lawbench.core.case import CASES, Case
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.law import LAWS, Law
+from lawbench.core.law import LAWS, Law, alarm
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.transforms import apply
@@ -160,7 +159,7 @@ def make_trial(
         Settings of the checks that solve again, carried by the trial.
     max_seconds : float, optional
         A wall-clock bound on the whole call, kept from outside the law's own budget
-        (`lawbench.core.budget.alarm`): it stops a law that ignores its ``max_seconds``.
+        (`lawbench.core.law.alarm`): it stops a law that ignores its ``max_seconds``.
 
     Returns
     -------

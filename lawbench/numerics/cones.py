@@ -29,8 +29,8 @@ import clarabel
 import numpy as np
 import scipy.sparse
 
-from lawbench.core import budget
 from lawbench.core.errors import SolverFailure
+from lawbench.core.law import current_budget
 from lawbench.core.mechanics import project
 from lawbench.core.units import binary_scale
 from lawbench.numerics.solvers import clarabel_settings
@@ -117,7 +117,7 @@ def solve_cone_qp(
     P, status = np.array(solution.x), str(solution.status)
     exact = polish(G, q, mu, d, P, False) if refine and np.isfinite(P).all() else None
     if exact is None and status == "MaxTime":
-        budget.current().out_of_time()
+        current_budget().out_of_time()
     if exact is None and status != "Solved":
         raise SolverFailure(f"clarabel status {status} after {solution.iterations} iterations")
     answer = (P if exact is None else exact) * (s / g)

@@ -36,7 +36,7 @@ NSGS does on the same problems; a slow but steady descent always finds new lows)
 costs about as much as a sweep, so, like Siconos' light-then-full evaluation, it is computed
 when the relative change of ``P`` over a sweep falls below a gate (``tol`` at first, lowered by
 the ratio of the error found to ``tol``), and every `CHECK_EVERY` sweeps. Each sweep spends one
-step of the solve's budget (`lawbench.core.budget`), so the loop ends at the law's ``max_steps``
+step of the solve's budget (`lawbench.core.law`), so the loop ends at the law's ``max_steps``
 or ``max_seconds``.
 
 The per-contact kernel and the sweep are compiled by numba at the first solve where it is
@@ -56,7 +56,7 @@ from typing import Any, TypeVar
 import numpy as np
 import scipy.sparse
 
-from lawbench.core import budget
+from lawbench.core.law import current_budget
 from lawbench.core.mechanics import fc3d_error, project
 
 _F = TypeVar("_F", bound=Callable[..., Any])
@@ -443,7 +443,7 @@ def solve_nsgs(
     blocks = _blocks(W.indptr, W.indices, W.data, size)
     inverse = inverses(blocks)
     P = np.zeros(m * size) if start is None else np.array(start, dtype=float)
-    spend, sweeps, gate, error, note = budget.current(), 0, tol, np.inf, ""
+    spend, sweeps, gate, error, note = current_budget(), 0, tol, np.inf, ""
     reference, reference_sweep = np.inf, 0
     while True:
         spend.step("Gauss-Seidel sweeps", note)

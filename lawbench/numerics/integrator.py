@@ -9,7 +9,7 @@ functions are smooth on the field's solutions and change sign at the event.
 changes sign in its stated direction, checked at ``samples`` points of each step's dense
 output; the change is located by Brent's method (`lawbench.numerics.roots.crossing`), and the state
 returned lies just past it, on the new branch. Every step and every event is spent from the
-open `lawbench.core.budget.Budget` of the solve, so ``max_steps``, ``max_events`` and
+open `lawbench.core.law.Budget` of the solve, so ``max_steps``, ``max_events`` and
 ``max_seconds`` are honoured the same way by every integrating law; a callback sees every step
 (and the last, partial one) with its dense output, for a recorded path or a peak.
 """
@@ -22,8 +22,8 @@ from functools import partial
 
 import numpy as np
 
-from lawbench.core import budget
 from lawbench.core.errors import SolverFailure
+from lawbench.core.law import current_budget
 from lawbench.numerics.roots import crossing
 
 Field = Callable[[float, np.ndarray], np.ndarray]
@@ -127,7 +127,7 @@ class EventIntegrator:
         SolverFailure
             When the solver fails.
         """
-        spend = budget.current()
+        spend = current_budget()
         extra = {} if jac is None else {"jac": jac}
         solver = self.method(fun, x0, y0, x_end, rtol=self.rtol, atol=self.atol, **extra)
         direction = np.asarray(direction, dtype=float)

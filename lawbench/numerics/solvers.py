@@ -30,8 +30,8 @@ import scipy.optimize
 import scipy.sparse
 import scipy.sparse.linalg
 
-from lawbench.core import budget
 from lawbench.core.errors import SolverFailure
+from lawbench.core.law import current_budget
 from lawbench.core.metric import SPARSE_SHARE, as_array, is_diagonal, is_sparse
 
 ROUNDING = 1e-12
@@ -58,7 +58,7 @@ def clarabel_settings(tol: float, max_iter: int) -> clarabel.DefaultSettings:
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = max_iter
-    settings.time_limit = budget.current().seconds_left
+    settings.time_limit = current_budget().seconds_left
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
     settings.tol_ktratio = max(tol, 1e-12)
     return settings
@@ -451,7 +451,7 @@ def _finish(
     if exact is not None:
         z = exact
     elif result.status == "MaxTime":
-        budget.current().out_of_time()
+        current_budget().out_of_time()
     elif result.status != "Solved":
         raise SolverFailure(f"clarabel status {result.status} after {result.iterations} iterations")
     return LCPResult(

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 
 from lawbench.checks import CheckResult
-from lawbench.core.budget import WALL_CLOCK
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.law import WALL_CLOCK
 from lawbench.core.trial import Trial
 from lawbench.core.verdicts import Verdict, of_error
 from lawbench.studies.study import Job

@@ -32,8 +32,8 @@ import pandas as pd
 from tqdm import tqdm
 
 from lawbench.checks import run_checks
-from lawbench.core.budget import alarm, stopped
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.law import alarm, stopped
 from lawbench.files.paths import output_file
 from lawbench.studies.guard import (
     BUDGET_S,
@@ -67,7 +67,7 @@ class Task:
 def compute(task: Task, alarm_s: float | None = None) -> dict[str, Any]:
     """The record row of one cell: outcome, checks, measures, cost, or the error that stopped it.
 
-    ``alarm_s`` guards the cell in this process (`lawbench.core.budget.alarm`).
+    ``alarm_s`` guards the cell in this process (`lawbench.core.law.alarm`).
     """
     start = time.perf_counter()
     heard: list[str] = []

@@ -56,7 +56,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.core import budget
+from lawbench.core.law import current_budget
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.laws.compliant.normal import Integration
@@ -221,7 +221,7 @@ class FrictionalIntegration(Integration):
         rtol = self.rtol
         # Four checks a step: a slip that stops and starts again within one step is still met.
         integrator = EventIntegrator(self.method, rtol, rtol * 1e-3, samples=4, stacked=True)
-        spend = budget.current()
+        spend = current_budget()
         t, self.steps, events = 0.0, 0, 0
         self.peak = np.zeros(m)
         self.history: list[tuple[float, np.ndarray, np.ndarray]] = []

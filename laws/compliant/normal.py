@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
-from lawbench.core import budget
 from lawbench.core.errors import NotApplicable
+from lawbench.core.law import current_budget
 from lawbench.core.mechanics import for_products
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
@@ -217,7 +217,7 @@ class Integration:
         g, un, P = problem.gaps / self.L, problem.un / self.V, np.zeros(m)
         rtol = options["tol"]
         integrator = EventIntegrator(self.method, rtol, rtol * 1e-3)
-        spend = budget.current()
+        spend = current_budget()
         t, self.steps, events = 0.0, 0, 0
         self.peak = np.zeros(m)
         self.history: list[tuple[float, np.ndarray, np.ndarray]] = []
