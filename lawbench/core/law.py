@@ -523,7 +523,10 @@ class _Watch:
 def _refuse_non_finite(name: str, **fields: Any) -> None:
     """Raise `SolverFailure` naming the first of ``fields`` that holds a non-finite number."""
     for field, value in fields.items():
-        finite = math.isfinite(value) if isinstance(value, float) else all_finite(value)
+        if isinstance(value, float):
+            finite = math.isfinite(value)
+        else:
+            finite = not value.size or all_finite(value)
         if not finite:
             raise SolverFailure(f"{name}: non-finite {field} {value}")
 

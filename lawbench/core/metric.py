@@ -31,8 +31,8 @@ SOLVE_BLOCK = 256
 
 
 def all_finite(array: np.ndarray) -> bool:
-    """Whether every entry of ``array`` is finite."""
-    return bool(np.isfinite(array).all())
+    """Whether every entry of ``array`` is finite (it has as many finite entries as entries)."""
+    return np.count_nonzero(np.isfinite(array)) == array.size
 
 
 def is_sparse(value: object) -> bool:

@@ -156,8 +156,23 @@ def _check_contacts(contacts: tuple[Contact, ...]) -> Contact | None:
     if len(indices) > CHECKED_ONE_BY_ONE:
         indices = _rows_out_of_range([contacts[j] for j in indices], indices)
     for j in indices:
-        contacts[j].validate(f"contacts[{j}]")
+        if not _in_range(contacts[j]):
+            contacts[j].validate(f"contacts[{j}]")
     return contacts[0] if len(first) == 1 else None
+
+
+@functools.lru_cache(maxsize=256)
+def _in_range(contact: Contact) -> bool:
+    """Whether every field of ``contact`` is in its range, decided once per distinct contact.
+
+    A contact is immutable, so the problems that share its coefficients share the verdict; the
+    one out of range is checked again under its label for the message.
+    """
+    try:
+        contact.validate("contact")
+    except InvalidProblem:
+        return False
+    return True
 
 
 def _rows_out_of_range(contacts: list[Contact], indices: list[int]) -> list[int]:
