@@ -35,7 +35,7 @@ compliance of the contact stores energy while the contact sticks and gives it ba
 A rigid law with Coulomb friction that ends a sticking impact at zero slip (Whittaker's,
 Moreau's, Darboux-Keller's, the energetic multiple-impact law's, and Brach's at ``e_t = 0``)
 leaves the contact point at rest: a contact angle of zero and a tangential restitution of
-exactly 5/7 throughout the sticking range, whatever ``e`` and ``mu``. Laws with tangential
+exactly 5/7 at every incidence below the onset of gross slip, whatever ``e``. Laws with tangential
 springs (Jia's, the compliant contacts' with tangential springs and sliders) reverse; how far
 depends on the ratio of tangential to normal stiffness and on ``mu``. Above the onset of gross
 slip every law gives Coulomb's sliding impulse and the laws agree with each other and with the
