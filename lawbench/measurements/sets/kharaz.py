@@ -6,7 +6,12 @@ are public; those shipped here are the readings in NETL MFiX's test ``tests/dem/
 (taken there from Di Renzo and Di Maio's reproduction of Kharaz's figures, Chem. Eng. Sci.
 59, 2004): the tangential restitution of the centre ``vx+ / vx-`` (8 points), the rebound spin
 (7 points, rad/s) and the rebound angle of the centre from the normal (9 points, degrees),
-each against the incidence angle from the normal (degrees).
+each against the incidence angle from the normal (degrees). The rebound angle of the contact
+point, ``atan(vt+ / vn+)`` with ``vt+`` the contact point's tangential velocity after the
+impact (negative: it moves back against the approach), is Kharaz's figure as digitized in
+Kratos Multiphysics' test 4 of Chung and Ooi's benchmarks (11 points, `contact_curve`,
+`CONTACT_SOURCE`): it falls to about -8.5 degrees at 20 degrees of incidence, the reversal
+that tangential compliance gives (Maw, Barber and Fawcett 1976).
 
 The set is the setup and the curves (`SETUP`, `curves`), and also measured impacts, one at
 each incidence of the tangential restitution where the spin was digitized around it: the spin
@@ -47,6 +52,27 @@ SOURCE = measured.Source(
     licence=(
         "MFiX is public-domain software of the U.S. DOE's NETL; the copy read states no "
         "licence file of its own"
+    ),
+)
+
+# The contact point's rebound angle, from a second repository.
+CONTACT = ("incidence_contact", "contact_angle")
+CONTACT_SOURCE = measured.Source(
+    paper=(
+        "A. H. Kharaz, D. A. Gorham, A. D. Salman, Powder Technology 120 (2001) 281-291; "
+        "points as digitized for Y. C. Chung, J. Y. Ooi, Benchmark tests for verifying discrete "
+        "element modelling codes at particle impact level, Granular Matter 13 (2011) 643-656, "
+        "test 4"
+    ),
+    repository="https://github.com/KratosMultiphysics/Kratos",
+    commit="f678879c5465efeaae8328b72b3fea70897e4721",
+    path=(
+        "applications/DEMApplication/tests/DEM3D_chung_ooi_tests/test4_data/paper_data/"
+        "benchmark4_graph3.dat (block #Experiment)"
+    ),
+    licence=(
+        "Kratos Multiphysics licence (BSD style with an advertising clause, license.txt); "
+        "only the measured numbers are kept"
     ),
 )
 
@@ -113,6 +139,16 @@ def curves() -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """The digitized points per quantity: ``(incidence in degrees, value)``."""
     data = measured.read_data(NAME)
     return {name: (data[x], data[y]) for name, (x, y) in QUANTITIES.items()}
+
+
+def contact_curve() -> tuple[np.ndarray, np.ndarray]:
+    """The contact point's rebound angle: ``(incidence in degrees, angle in degrees)``.
+
+    The angle is ``atan(vt+ / vn+)`` from the anvil's normal, ``vt+`` the tangential velocity
+    of the sphere's point of contact after the impact, positive along the approach.
+    """
+    data = measured.read_data(NAME)
+    return data[CONTACT[0]], data[CONTACT[1]]
 
 
 def _load() -> tuple[list[measured.MeasuredImpact], np.ndarray, measured.Processing]:
