@@ -116,7 +116,7 @@ def impact_problem(incidence: float) -> ImpactProblem:
 def frictional_laws() -> list[str]:
     """The registered laws whose tags treat the setup's one frictional planar contact."""
     probe = impact_problem(45.0)
-    return [name for name in LAWS.names() if LAWS.get(name).tags.refusal(probe) is None]
+    return [name for name in LAWS.names() if LAWS.get(name).refusal(probe) is None]
 
 
 def rebound(v_before: np.ndarray, v_after: np.ndarray) -> dict[str, float]:
