@@ -110,7 +110,8 @@ class ProblemBatch:
     coefficients : mapping of str to array (B, m)
         Contact coefficients per problem and contact, in the ranges of `Contact`: restitution
         (``e``, ``e_newton``, ``e_poisson``, ``e_energy``, in [0, 1]), and with a tangential
-        Jacobian Brach's ``e_t`` (in [-1, 1]) and Coulomb's ``mu`` (>= 0, 0 where not given).
+        Jacobian Brach's ``e_t`` (in [-1, 1]) and Coulomb's ``mu`` (>= 0); those not given are
+        the defaults of `Contact`.
     Wt : array (B, n, m*d) or (n, m*d), optional
         Tangential Jacobians, d = 1 (planar) or 2 (spatial) directions per contact; None
         without friction.
@@ -151,8 +152,10 @@ class ProblemBatch:
         for name in (f for f in stacked if getattr(self, f).shape[0] != batch):
             raise InvalidProblem(f"{name} holds {getattr(self, name).shape[0]} problems, v {batch}")
         coefficients = _coefficients(self.coefficients, batch, m)
-        if self.Wt is None:
-            for name in (f for f in FRICTION_COEFFICIENTS if f in coefficients):
+        for name in FRICTION_COEFFICIENTS:
+            if self.Wt is not None:
+                coefficients.setdefault(name, np.zeros((batch, m)))
+            elif name in coefficients:
                 raise InvalidProblem(f"coefficient {name!r} without a tangential Jacobian Wt")
         set_(self, "coefficients", coefficients)
         self._check_normals(self._factor_mass())
