@@ -32,7 +32,6 @@ CONDITION = 1e8
 # The eight angles whose samples give the Fourier coefficients of the slip condition exactly.
 _ANGLES = 2 * np.pi * np.arange(8) / 8
 _SAMPLES = np.stack([np.cos(_ANGLES), np.sin(_ANGLES)])
-_ORDERS = np.arange(-2, 3)
 NEWTON_STEPS = 20
 
 
@@ -176,24 +175,33 @@ def _slip_directions(
     roots = np.linalg.eigvals(companion)
     with np.errstate(divide="ignore"):
         valid = (np.abs(np.log(np.abs(roots))) <= 1e-4) & ~none[:, None]
-    theta = _polished(fourier[:, _ORDERS], np.angle(roots))
+    theta = _polished(fourier[:, [6, 7, 0, 1, 2]], np.angle(roots))
     return np.stack([np.cos(theta), np.sin(theta)], axis=2), valid, alone
 
 
 def _polished(a: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """Newton's method on ``Re sum a_k exp(i k theta)`` from each angle (B, S)."""
-    moving = np.ones(theta.shape, dtype=bool)
+    """Newton's method on ``g = Re sum_k a_k exp(i k theta)`` (k = -2..2) from each angle (B, S).
+
+    ``g`` is real, so ``a_-k`` is the conjugate of ``a_k`` and ``g = a_0 + 2 Re(a_1 z + a_2 z^2)``
+    with ``z = exp(i theta)``. Each angle stops as the one-by-one path's does: at a zero slope,
+    or once a step is below 1e-15; only the angles still moving are computed again.
+    """
+    a = np.broadcast_to(a[:, None, 2:], (*theta.shape, 3))[..., :]
+    theta, a = theta.ravel().copy(), a.reshape(-1, 3)
+    moving = np.arange(theta.size)
     for _ in range(NEWTON_STEPS):
-        z = np.exp(1j * _ORDERS * theta[:, :, None])
-        value = np.real(np.einsum("kj,ksj->ks", a, z))
-        slope = np.real(np.einsum("kj,ksj->ks", 1j * _ORDERS * a, z))
+        angle, c = theta[moving], a[moving]
+        z1, z2 = np.exp(1j * angle), np.exp(2j * angle)
+        value = c[:, 0].real + 2 * (c[:, 1] * z1 + c[:, 2] * z2).real
+        slope = -2 * (c[:, 1] * z1 + 2 * c[:, 2] * z2).imag
         with np.errstate(divide="ignore", invalid="ignore"):
             step = value / slope
-        moving &= (slope != 0.0) & ~(np.abs(step) < 1e-15)
-        if not moving.any():
+        going = (slope != 0.0) & ~(np.abs(step) < 1e-15)
+        moving, step = moving[going], step[going]
+        if not moving.size:
             break
-        theta = np.where(moving, theta - step, theta)
-    return theta
+        theta[moving] -= step
+    return theta.reshape(-1, 4)
 
 
 def _admissible(

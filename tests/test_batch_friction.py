@@ -1,7 +1,8 @@
 """One-contact frictional impacts in a batch: the batch path equals the one-by-one path.
 
-Whittaker's, Brach's and Moreau's one-contact laws are closed forms per mode, vectorized over
-the batch; every other law takes a frictional batch one by one. On random bodies (full mass
+Whittaker's, Brach's and Moreau's one-contact laws are closed forms per mode, and
+Darboux-Keller's planar impulse-time phases are too, vectorized over the batch; every other law
+takes a frictional batch one by one. On random bodies (full mass
 matrices, planar and spatial contacts, e from 0 to 1, mu from 0 to large, sticking and
 sliding) each answer must be `Law.resolve`'s to 1e-10 of the problem's speed and impulse.
 """
@@ -48,6 +49,14 @@ def assert_equal_one_by_one(law, batch, options=None):
     return together
 
 
+def assert_both_regimes(batch, together):
+    """Impulses inside the Coulomb cone (stick) and on its boundary (slip) both occur."""
+    Pt = np.linalg.norm(together.Pt, axis=1)
+    bound = batch.mu[:, 0] * together.Pn[:, 0]
+    on_cone = np.isclose(Pt, bound, rtol=1e-9) & (bound > 0)
+    assert on_cone.any() and (Pt < bound * (1 - 1e-6)).any()
+
+
 @pytest.mark.parametrize("d", [1, 2])
 @pytest.mark.parametrize(("law", "count"), [("whittaker", 150), ("brach", 150), ("moreau", 30)])
 def test_a_frictional_batch_equals_one_by_one(law, count, d):
@@ -55,11 +64,16 @@ def test_a_frictional_batch_equals_one_by_one(law, count, d):
     together = assert_equal_one_by_one(law, batch)
     assert together.diagnostics["formulation"].startswith("closed form (batch)")
     assert together.diagnostics["one_by_one"] < count // 4
-    # Both regimes are met: impulses inside the Coulomb cone (stick) and on its boundary.
-    Pt = np.linalg.norm(together.Pt, axis=1)
-    bound = batch.mu[:, 0] * together.Pn[:, 0]
-    on_cone = np.isclose(Pt, bound, rtol=1e-9) & (bound > 0)
-    assert on_cone.any() and (Pt < bound * (1 - 1e-6)).any()
+    assert_both_regimes(batch, together)
+
+
+@pytest.mark.parametrize("termination", ["energetic", "newton", "poisson"])
+def test_darboux_keller_phases_in_a_planar_batch_equal_one_by_one(termination):
+    batch = random_contacts(7, 150, 1)
+    together = assert_equal_one_by_one("darboux_keller", batch, {"termination": termination})
+    assert together.diagnostics["formulation"] == "exact piecewise (batch)"
+    assert together.diagnostics["one_by_one"] == 0
+    assert_both_regimes(batch, together)
 
 
 def test_moreau_leaves_problems_without_a_unique_solution_to_its_solver():
@@ -73,9 +87,16 @@ def test_moreau_leaves_problems_without_a_unique_solution_to_its_solver():
 
 @pytest.mark.parametrize("d", [1, 2])
 def test_a_law_without_a_batch_path_takes_a_frictional_batch_one_by_one(d):
-    batch = random_contacts(10 + d, 12, d)
-    together = assert_equal_one_by_one("darboux_keller", batch)
+    batch = random_contacts(11, 6, d)
+    together = assert_equal_one_by_one("jia", batch)
     assert together.diagnostics["formulation"] == "one by one"
+
+
+def test_spatial_slip_that_may_turn_is_left_to_the_integrator():
+    batch = random_contacts(12, 10, 2)
+    together = assert_equal_one_by_one("darboux_keller", batch)
+    frictional = int(np.count_nonzero((batch.mu[:, 0] > 0) & (batch.un[:, 0] < 0)))
+    assert together.diagnostics["one_by_one"] == frictional > 0
 
 
 def test_a_frictionless_law_refuses_a_frictional_batch_as_it_refuses_a_problem():
