@@ -106,6 +106,7 @@ def solutions(batch: ProblemBatch, normal: np.ndarray, tolerance: float) -> Solu
         candidates[plain, 0] = frictionless[plain]
         kept[plain] = False
         kept[plain, 0] = True
+        alone &= ~plain
     GP = np.einsum("kij,kcj->kci", G, candidates)
     T_plus = T_minus[:, None] + np.einsum("ki,kci->kc", u, candidates)
     T_plus += 0.5 * np.einsum("kci,kci->kc", candidates, GP)
@@ -186,8 +187,9 @@ def _polished(a: np.ndarray, theta: np.ndarray) -> np.ndarray:
     with ``z = exp(i theta)``. Each angle stops as the one-by-one path's does: at a zero slope,
     or once a step is below 1e-15; only the angles still moving are computed again.
     """
-    a = np.broadcast_to(a[:, None, 2:], (*theta.shape, 3))[..., :]
-    theta, a = theta.ravel().copy(), a.reshape(-1, 3)
+    # a_0, a_1, a_2 of every angle's problem, one row per angle.
+    a = np.repeat(a[:, 2:], theta.shape[1], axis=0)
+    theta = theta.ravel().copy()
     moving = np.arange(theta.size)
     for _ in range(NEWTON_STEPS):
         angle, c = theta[moving], a[moving]

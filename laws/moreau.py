@@ -325,8 +325,9 @@ class Moreau(Law):
 
         With friction, one contact: every mode of Coulomb's law in closed form
         (`lawbench.laws._one_contact_batch`), where the law has exactly one solution (the one
-        the cone QPs find); a problem with several or none is left to `_resolve`, and so is
-        Anitescu's relaxation.
+        the cone QPs find, when their fixed point settles within ``max_steps``: where it would
+        not, the batch still gives that solution); a problem with several or none is left to
+        `_resolve`, and so is Anitescu's relaxation.
         """
         if batch.m > ENUMERATION_MAX:
             return None

@@ -285,7 +285,11 @@ class ProblemBatch:
 
     @cached_property
     def frictional(self) -> bool:
-        """Whether some problem has a tangential Jacobian and a positive mu."""
+        """Whether some problem has a tangential Jacobian and a positive mu.
+
+        With `d` and `closed_count`, what a law's `Tags.refusal` reads of a problem: a law's
+        tags judge a batch as they judge each of its problems.
+        """
         return self.Wt is not None and bool((self.mu > 0).any())
 
     @property
