@@ -82,9 +82,10 @@ def _coefficients(given: object, batch: int, m: int) -> dict[str, np.ndarray]:
             )
         array = np.broadcast_to(_numbers(f"coefficients[{name!r}]", value), (batch, m))
         low, high = COEFFICIENTS[name]
-        # NaN fails both comparisons; an unbounded range still refuses infinity.
-        inside = (array >= low) & (array <= high) & (array < np.inf)
-        if not inside.all():
+        # NaN fails every comparison; an unbounded range still refuses infinity.
+        largest = array.max()
+        if not (array.min() >= low and largest <= high and largest < np.inf):
+            inside = (array >= low) & (array <= high) & (array < np.inf)
             k, j = (int(i) for i in np.argwhere(~inside)[0])
             value = array[k, j]
             bounds = f"in [{low:g}, {high:g}]" if high < np.inf else f">= {low:g}"
