@@ -124,8 +124,8 @@ def batch_of_impacts(size: int, repeats: int) -> list[str]:
 
 
 # Problems of a frictional batch solved one by one for the per-impact figure: the slowest laws
-# take tens of milliseconds each.
-ONE_BY_ONE_SAMPLE = 20
+# take tens of milliseconds each. The first PROBE of them tell whether the batch path takes any.
+ONE_BY_ONE_SAMPLE, PROBE = 20, 5
 
 
 def ellipse_bounces(size: int, rng: np.random.Generator) -> ProblemBatch:
@@ -195,16 +195,17 @@ def frictional_batches(size: int, repeats: int) -> list[str]:
 def _batch_against_alone(law: Law, batch: ProblemBatch, repeats: int) -> str:
     """One law's line: a batch built from its arrays and solved, against solves one by one.
 
-    A law whose batch path leaves every problem of a sample to the one-by-one path (spatial
-    slip that the law integrates) is timed on that sample only: its batch would cost as much.
+    A law whose batch path leaves every problem of a `PROBE` to the one-by-one path (spatial
+    slip that the law integrates, 0.4 s an impact) is timed on the probe only: its batch would
+    cost as much.
     """
-    count = ONE_BY_ONE_SAMPLE
-    coefficients = {name: values[:count] for name, values in batch.coefficients.items()}
-    head = (batch.M[:count], batch.Wn[:count], batch.v[:count], coefficients, batch.Wt[:count])
+    coefficients = {name: values[:PROBE] for name, values in batch.coefficients.items()}
+    head = (batch.M[:PROBE], batch.Wn[:PROBE], batch.v[:PROBE], coefficients, batch.Wt[:PROBE])
     probe = solve_batch(law, ProblemBatch(*head))
-    if probe.diagnostics["one_by_one"] == count:
-        per_impact = probe.diagnostics["wall_time_s"] / count
+    if probe.diagnostics["one_by_one"] == PROBE:
+        per_impact = probe.diagnostics["wall_time_s"] / PROBE
         return f"  {law.name}: one by one here, {duration(per_impact)} per impact"
+    count = ONE_BY_ONE_SAMPLE
     arrays = (batch.M, batch.Wn, batch.v, batch.coefficients, batch.Wt)
     sample = [batch.problem(k) for k in range(count)]
     whole = best_time(lambda: solve_batch(law, ProblemBatch(*arrays)), repeats)
