@@ -43,7 +43,7 @@ check reports on the coupled scenes.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -56,8 +56,13 @@ from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
 from lawbench.laws._claims import keeps_energy
 
+if TYPE_CHECKING:
+    from lawbench.core.batch import ProblemBatch
+
 # Below this fraction of |un-| a slip velocity counts as zero.
 NO_SLIP = 1e-12
+# Contact Delassus matrices of a larger condition number are solved one by one (least squares).
+CONDITION = 1e8
 
 _REVERSAL_GAIN = (
     "the tangential impulse, bounded by mu Pn and opposing the pre-impact slip, drives the "
@@ -116,6 +121,21 @@ class Brach(Law):
         }
         return Outcome.from_impulses(problem, np.array([Pn]), Pt, diagnostics=diagnostics)
 
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """Both branches in closed form for every problem (`_batch_impulses`)."""
+        un = batch.un[:, 0]
+        approaching = un < 0.0
+        e = batch.restitution("kinematic")[:, 0]
+        G = batch.contact_delassus
+        if batch.d == 0:
+            Pn = np.where(approaching, -(1.0 + e) * un / G[:, 0, 0], 0.0)
+            return Pn[:, None], "closed form (batch)"
+        P = _batch_impulses(G, un, batch.ut, e, batch.coefficients["e_t"][:, 0], batch.mu[:, 0])
+        P[~approaching] = 0.0
+        return P, "closed form (batch)"
+
 
 def _decoupled(G: np.ndarray) -> bool:
     """Whether the normal and tangential directions are uncoupled and Gtt is isotropic."""
@@ -148,6 +168,42 @@ def _impulses(
         )
     Pn = -(1.0 + e) * un / denominator
     return Pn, -mu * Pn * slip, "slip", slip
+
+
+def _batch_impulses(
+    G: np.ndarray, un: np.ndarray, ut: np.ndarray, e: np.ndarray, e_t: np.ndarray, mu: np.ndarray
+) -> np.ndarray:
+    """`_impulses` for a batch: ``(Pn, Pt)`` (B, 1 + d), NaN where `_impulses` must decide.
+
+    Left to it: a contact Delassus matrix too close to singular for the stick branch
+    (`CONDITION`, where it solves by least squares), and strong coupling (it refuses).
+    """
+    target = np.concatenate([(-(1.0 + e) * un)[:, None], -(1.0 + e_t)[:, None] * ut], axis=1)
+    values = np.linalg.eigvalsh(G)
+    alone = ~(values[:, -1] < CONDITION * values[:, 0])
+    stick = np.linalg.solve(
+        np.where(alone[:, None, None], np.eye(G.shape[1]), G), target[..., None]
+    )
+    stick = stick[..., 0]
+    Pn, Pt = stick[:, 0], stick[:, 1:]
+    speed, tangential = np.linalg.norm(ut, axis=1), np.linalg.norm(Pt, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slip = np.where(
+            (speed > NO_SLIP * np.abs(un))[:, None],
+            ut / speed[:, None],
+            np.where((tangential > 0)[:, None], -Pt / tangential[:, None], np.eye(ut.shape[1])[0]),
+        )
+    sticks = (Pn >= 0.0) & (tangential <= mu * Pn)
+    denominator = G[:, 0, 0] - mu * np.einsum("kj,kj->k", G[:, 0, 1:], slip)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Pn_slip = -(1.0 + e) * un / denominator
+    P = np.where(
+        sticks[:, None],
+        stick,
+        np.concatenate([Pn_slip[:, None], -(mu * Pn_slip)[:, None] * slip], axis=1),
+    )
+    P[alone | (~sticks & (denominator <= 0.0))] = np.nan
+    return P
 
 
 LAWS.register(Brach())

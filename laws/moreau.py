@@ -126,6 +126,7 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Claim
+from lawbench.laws import _one_contact_batch
 from lawbench.laws._claims import (
     PAOLI_DISCONTINUITY,
     RIGID_DISPERSION,
@@ -319,18 +320,33 @@ class Moreau(Law):
     def _resolve_batch(
         self, batch: ProblemBatch, options: dict[str, Any]
     ) -> tuple[np.ndarray, str] | None:
-        """The per-contact LCP by active-set enumeration, for every problem at once."""
+        """The per-contact LCP by active-set enumeration, for every problem at once.
+
+        With friction, one contact: every mode of Coulomb's law in closed form
+        (`lawbench.laws._one_contact_batch`), where the law has exactly one solution (the one
+        the cone QPs find, when their fixed point settles within ``max_steps``: where it would
+        not, the batch still gives that solution); a problem with several or none is left to
+        `_resolve`, and so is Anitescu's relaxation.
+        """
         if batch.m > ENUMERATION_MAX:
             return None
         un = batch.un
         restituted = np.minimum(un, 0.0) if options["separating"] == "unilateral" else un
-        Pn, found = enumerate_lcp(batch.delassus, un + batch.restitution("kinematic") * restituted)
+        bias = un + batch.restitution("kinematic") * restituted
+        if batch.frictional:
+            if batch.m > 1 or options["friction"] == "relaxed":
+                return None
+            found = _one_contact_batch.solutions(batch, bias, COULOMB_TOLERANCE)
+            return found.unique(), "closed form (batch)"
+        Pn, found = enumerate_lcp(batch.delassus, bias)
         if not found.all():
             return None
         return Pn, "LCP (active-set enumeration, batch)"
 
 
 UNDAMPED = 20
+# Relative tolerance of Coulomb's conditions on a mode's closed form at one contact.
+COULOMB_TOLERANCE = 1e-9
 
 
 def _resolve_friction(

@@ -72,7 +72,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.optimize
@@ -83,6 +83,7 @@ from lawbench.core.metric import is_diagonal, kinetic_energy
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.tags import Tags
+from lawbench.laws import _one_contact_batch
 from lawbench.laws._claims import (
     PAOLI_DISCONTINUITY,
     RIGID_DISPERSION,
@@ -91,6 +92,9 @@ from lawbench.laws._claims import (
     separating_held,
 )
 from lawbench.numerics.lemke import RayTermination, lemke
+
+if TYPE_CHECKING:
+    from lawbench.core.batch import ProblemBatch
 
 # Largest number of planar contacts whose 4^m mode combinations are enumerated.
 MAX_ENUMERATED = 4
@@ -444,6 +448,21 @@ class Whittaker(Law):
             formulation = f"closed form, {modes[0].rstrip(' +-')}"
         uniqueness = "unchecked" if not checked else "unique" if len(solutions) == 1 else "several"
         return _outcome(setup, chosen, solutions, formulation, uniqueness, extra)
+
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """One contact: every mode in closed form for every problem, the least energy chosen.
+
+        As `_resolve` chooses among the solutions; a problem without a solution, or whose modes
+        need more than a closed form, is left to it (`lawbench.laws._one_contact_batch`).
+        """
+        if batch.m > 1:
+            return None
+        un = batch.un
+        bias = un + batch.restitution("kinematic") * np.minimum(un, 0.0)
+        found = _one_contact_batch.solutions(batch, bias, TOLERANCE)
+        return found.least_energy(), "closed form (batch)"
 
 
 def _choose(setup: _Setup, solutions: list[np.ndarray]) -> np.ndarray:

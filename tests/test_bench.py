@@ -28,7 +28,13 @@ from lawbench.core.law import LAWS
 def test_the_benchmark_prints_every_figure_with_its_peer():
     text = report(quick=True)
     assert text.startswith("lawbench bench on ")
-    lines = ("one three-ball", "a batch of", "n-ball chain", "bytecode cached")
+    lines = (
+        "one three-ball",
+        "a batch of",
+        "frictional impacts",
+        "n-ball chain",
+        "bytecode cached",
+    )
     for line in (*lines, "from its parameters"):
         assert line in text
     integrating = [

@@ -36,7 +36,7 @@ from lawbench.cases._chains import chain_problem
 from lawbench.core.batch import ProblemBatch
 from lawbench.core.case import CASES
 from lawbench.core.errors import SolverFailure
-from lawbench.core.law import LAWS
+from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import solve, solve_batch
 
@@ -121,6 +121,101 @@ def batch_of_impacts(size: int, repeats: int) -> list[str]:
         f"a batch of {size:,} random three-ball {law.name} impacts (validation included):",
         row("lawbench solve_batch, per impact", whole / size, peers),
     ]
+
+
+# Problems of a frictional batch solved one by one for the per-impact figure: the slowest laws
+# take tens of milliseconds each. The first PROBE of them tell whether the batch path takes any.
+ONE_BY_ONE_SAMPLE, PROBE = 20, 5
+
+
+def ellipse_bounces(size: int, rng: np.random.Generator) -> ProblemBatch:
+    """Planar one-contact impacts like a thrown ellipse's bounces on a rough floor.
+
+    Mass 36.4 g and inertia 1.68e-5 kg m^2 (coordinates x, y, angle); the contact point at
+    lever arms ``(x, y)`` within 3 cm of the centre gives the normal row ``(0, 1, x)`` and the
+    tangent row ``(1, 0, y)``; falling at 1 to 3 m/s, sliding at up to 1 m/s, spinning at up
+    to 50 rad/s; e in [0, 1], mu in [0, 1].
+    """
+    M = np.diag([0.0364, 0.0364, 1.68e-5])
+    x, y = rng.uniform(-0.03, 0.03, (2, size))
+    Wn = np.stack([np.zeros(size), np.ones(size), x], axis=1)[:, :, None]
+    Wt = np.stack([np.ones(size), np.zeros(size), y], axis=1)[:, :, None]
+    v = np.stack(
+        [rng.uniform(-1, 1, size), -rng.uniform(1, 3, size), rng.uniform(-50, 50, size)], axis=1
+    )
+    coefficients = {"e": rng.uniform(0, 1, (size, 1)), "mu": rng.uniform(0, 1, (size, 1))}
+    return ProblemBatch(M, Wn, v, coefficients, Wt)
+
+
+def cube_corners(size: int, rng: np.random.Generator) -> ProblemBatch:
+    """Spatial one-contact impacts of a 0.37 kg cube of 10 cm landing on a corner.
+
+    Coordinates: the centre's velocity, then the angular velocity; the corner at ``r`` from
+    the centre (below it) gives the rows ``(n, r x n)`` of the normal ``n = z`` and of the
+    tangents x and y.
+    """
+    M = np.diag([0.37] * 3 + [6.773e-4] * 3)
+    r = rng.uniform(-0.05, 0.05, (size, 3))
+    r[:, 2] = -np.abs(r[:, 2]) - 0.02
+    axes = np.eye(3)
+    rows = [np.concatenate([np.broadcast_to(a, (size, 3)), np.cross(r, a)], axis=1) for a in axes]
+    v = np.concatenate(
+        [
+            rng.uniform(-1, 1, (size, 2)),
+            -rng.uniform(1, 3, (size, 1)),
+            rng.normal(0, 10, (size, 3)),
+        ],
+        axis=1,
+    )
+    coefficients = {"e": rng.uniform(0, 1, (size, 1)), "mu": rng.uniform(0, 1, (size, 1))}
+    return ProblemBatch(M, rows[2][:, :, None], v, coefficients, np.stack(rows[:2], axis=2))
+
+
+def frictional_batches(size: int, repeats: int) -> list[str]:
+    """Laws with a vectorized path on ``size`` one-contact frictional impacts, planar and spatial.
+
+    The batch (validation included) against the same impacts one by one, timed on
+    `ONE_BY_ONE_SAMPLE` of them; the laws are the registered ones that treat friction and
+    override `Law._resolve_batch`.
+    """
+    laws = [
+        law
+        for law in LAWS.values()
+        if law.tags.friction and type(law)._resolve_batch is not Law._resolve_batch
+    ]
+    lines = []
+    scenes = (("planar, ellipse", ellipse_bounces), ("spatial, cube corner", cube_corners))
+    for label, build in scenes:
+        batch = build(size, np.random.default_rng(2))
+        lines.append(f"{size:,} one-contact frictional impacts ({label}), per impact:")
+        lines += [_batch_against_alone(law, batch, repeats) for law in laws]
+    return lines
+
+
+def _batch_against_alone(law: Law, batch: ProblemBatch, repeats: int) -> str:
+    """One law's line: a batch built from its arrays and solved, against solves one by one.
+
+    A law whose batch path leaves every problem of a `PROBE` to the one-by-one path (spatial
+    slip that the law integrates, 0.4 s an impact) is timed on the probe only: its batch would
+    cost as much.
+    """
+    coefficients = {name: values[:PROBE] for name, values in batch.coefficients.items()}
+    head = (batch.M[:PROBE], batch.Wn[:PROBE], batch.v[:PROBE], coefficients, batch.Wt[:PROBE])
+    probe = solve_batch(law, ProblemBatch(*head))
+    if probe.diagnostics["one_by_one"] == PROBE:
+        per_impact = probe.diagnostics["wall_time_s"] / PROBE
+        return f"  {law.name}: one by one here, {duration(per_impact)} per impact"
+    count = ONE_BY_ONE_SAMPLE
+    arrays = (batch.M, batch.Wn, batch.v, batch.coefficients, batch.Wt)
+    sample = [batch.problem(k) for k in range(count)]
+    whole = best_time(lambda: solve_batch(law, ProblemBatch(*arrays)), repeats)
+    alone = best_time(lambda: [law.resolve(problem) for problem in sample], 1)
+    left = solve_batch(law, batch).diagnostics["one_by_one"]
+    return row(
+        f"{law.name} solve_batch ({left} one by one)",
+        whole / len(batch),
+        {"one by one": alone / count},
+    )
 
 
 def long_chains(sizes: tuple[int, ...], repeats: int, siconos_up_to: int = 0) -> list[str]:
@@ -276,6 +371,7 @@ def report(quick: bool = False) -> str:
         + ", ".join(f"{k}={v}" for k, v in threads.items()),
         *small_impact(repeats),
         *batch_of_impacts(10_000 if quick else 100_000, repeats),
+        *frictional_batches(1000 if quick else 10_000, repeats),
         *(long_chains((100, 1000), repeats) if quick else long_chains(CHAINS, repeats, 1000)),
         *chain_from_scene(SCENE_CHAIN, repeats),
         *integrating_chains(QUICK_INTEGRATING_SIZES if quick else INTEGRATING_SIZES),

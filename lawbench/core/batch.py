@@ -7,9 +7,11 @@ the Delassus matrices, `lawbench.numerics.solvers.enumerate_lcp`) solves every p
 numpy calls; the others are solved one by one. Either way the answer equals the one-by-one path to
 rounding.
 
-Sign conventions as everywhere: ``un = Wn.T @ v``, ``Pn >= 0`` pushes apart,
-``v_plus = v + M^-1 Wn Pn``. Batches are frictionless and simultaneous (no tangential
-Jacobian, zero gaps): the problems where many small impacts are solved at once.
+Sign conventions as everywhere: ``un = Wn.T @ v``, ``ut = Wt.T @ v``, ``Pn >= 0`` pushes apart,
+``v_plus = v + M^-1 (Wn Pn + Wt Pt)``. Batches are simultaneous (zero gaps), frictionless or
+with a tangential Jacobian of d = 1 (planar) or 2 (spatial) directions per contact and a
+Coulomb ``mu`` per problem and contact: the measured impacts a fitted law solves thousands of
+times.
 """
 
 from __future__ import annotations
@@ -24,15 +26,22 @@ import numpy as np
 
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.metric import all_finite
-from lawbench.core.problem import RESTITUTION_FIELDS, Contact, ImpactProblem
+from lawbench.core.problem import CONTACT_RANGES, RESTITUTION_FIELDS, Contact, ImpactProblem
 from lawbench.core.units import UNIT_BAND
 
 if TYPE_CHECKING:
     import pandas as pd
 
 _OVERFLOW = "M is too close to singular (its inverse overflows)"
-# Contact fields a batch carries per problem and contact, with their allowed ranges.
-COEFFICIENTS = {"e": (0.0, 1.0), "e_newton": (0.0, 1.0), "e_poisson": (0.0, 1.0)}
+# Contact fields a batch carries per problem and contact, with their allowed ranges (those of
+# `ImpactProblem`'s contacts).
+COEFFICIENTS = {
+    name: (low, np.inf if high is None else high)
+    for name, low, high, _ in CONTACT_RANGES
+    if name in ("e", *RESTITUTION_FIELDS.values(), "e_t", "mu")
+}
+# The coefficients only a batch with a tangential Jacobian carries.
+FRICTION_COEFFICIENTS = ("e_t", "mu")
 
 
 def _numbers(name: str, value: object) -> np.ndarray:
@@ -58,9 +67,38 @@ def _stack(name: str, value: object, shape: tuple[int, ...], batch: int | None) 
     return array
 
 
+def _coefficients(given: object, batch: int, m: int) -> dict[str, np.ndarray]:
+    """The batch's coefficients (B, m), checked in their ranges; ``e`` is 1 where not given."""
+    if not isinstance(given, Mapping):
+        raise TypeError(
+            "coefficients must be a mapping of coefficient names to values, not "
+            f"{type(given).__name__}"
+        )
+    coefficients = {}
+    for name, value in given.items():
+        if name not in COEFFICIENTS:
+            raise InvalidProblem(
+                f"unknown batch coefficient {name!r}; known: {', '.join(COEFFICIENTS)}"
+            )
+        array = np.broadcast_to(_numbers(f"coefficients[{name!r}]", value), (batch, m))
+        low, high = COEFFICIENTS[name]
+        # NaN fails every comparison; an unbounded range still refuses infinity.
+        largest = array.max()
+        if not (array.min() >= low and largest <= high and largest < np.inf):
+            inside = (array >= low) & (array <= high) & (array < np.inf)
+            k, j = (int(i) for i in np.argwhere(~inside)[0])
+            value = array[k, j]
+            bounds = f"in [{low:g}, {high:g}]" if high < np.inf else f">= {low:g}"
+            must = f"must be {bounds}" if np.isfinite(value) else "must be a finite number"
+            raise InvalidProblem(f"problem {k}: contacts[{j}].{name} = {value}: {must}")
+        coefficients[name] = array
+    coefficients.setdefault("e", np.ones((batch, m)))
+    return coefficients
+
+
 @dataclass(frozen=True, eq=False)
 class ProblemBatch:
-    """B frictionless simultaneous impact problems of one shape, validated once.
+    """B simultaneous impact problems of one shape, validated once.
 
     Parameters
     ----------
@@ -71,8 +109,13 @@ class ProblemBatch:
     v : array (B, n)
         Pre-impact velocities; B is the number of rows.
     coefficients : mapping of str to array (B, m)
-        Restitution coefficients per problem and contact (``e``, ``e_newton``,
-        ``e_poisson``), in [0, 1].
+        Contact coefficients per problem and contact, in the ranges of `Contact`: restitution
+        (``e``, ``e_newton``, ``e_poisson``, ``e_energy``, in [0, 1]), and with a tangential
+        Jacobian Brach's ``e_t`` (in [-1, 1]) and Coulomb's ``mu`` (>= 0); those not given are
+        the defaults of `Contact`.
+    Wt : array (B, n, m*d) or (n, m*d), optional
+        Tangential Jacobians, d = 1 (planar) or 2 (spatial) directions per contact; None
+        without friction.
 
     Raises
     ------
@@ -84,6 +127,7 @@ class ProblemBatch:
     Wn: np.ndarray
     v: np.ndarray
     coefficients: dict[str, np.ndarray] = field(default_factory=dict)
+    Wt: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         v = _numbers("v", self.v)
@@ -97,37 +141,38 @@ class ProblemBatch:
         set_(self, "v", _stack("v", v, (n,), None))
         set_(self, "M", _stack("M", self.M, (n, n), batch))
         set_(self, "Wn", _stack("Wn", self.Wn, (n, m), batch))
-        for name in (f for f in ("M", "Wn") if getattr(self, f).shape[0] != batch):
+        stacked = ("M", "Wn")
+        if self.Wt is not None:
+            columns = np.shape(self.Wt)[-1] if np.ndim(self.Wt) >= 2 else 0
+            if columns not in (m, 2 * m):
+                raise InvalidProblem(
+                    f"Wt has shape {np.shape(self.Wt)}, expected (B, {n}, {m}*d) with d = 1 or 2"
+                )
+            set_(self, "Wt", _stack("Wt", self.Wt, (n, columns), batch))
+            stacked += ("Wt",)
+        for name in (f for f in stacked if getattr(self, f).shape[0] != batch):
             raise InvalidProblem(f"{name} holds {getattr(self, name).shape[0]} problems, v {batch}")
-        if not isinstance(self.coefficients, Mapping):
-            raise TypeError(
-                "coefficients must be a mapping of coefficient names to values, not "
-                f"{type(self.coefficients).__name__}"
-            )
-        coefficients = {}
-        for name, value in self.coefficients.items():
-            if name not in COEFFICIENTS:
-                raise InvalidProblem(
-                    f"unknown batch coefficient {name!r}; known: {', '.join(COEFFICIENTS)}"
-                )
-            array = np.broadcast_to(_numbers(f"coefficients[{name!r}]", value), (batch, m))
-            low, high = COEFFICIENTS[name]
-            # NaN fails both comparisons.
-            if not (array.min() >= low and array.max() <= high):
-                k, j = (int(i) for i in np.argwhere(~((array >= low) & (array <= high)))[0])
-                raise InvalidProblem(
-                    f"problem {k}: contacts[{j}].{name} = {array[k, j]}: must be in "
-                    f"[{low:g}, {high:g}]"
-                )
-            coefficients[name] = array
-        coefficients.setdefault("e", np.ones((batch, m)))
+        coefficients = _coefficients(self.coefficients, batch, m)
+        for name in FRICTION_COEFFICIENTS:
+            if self.Wt is not None:
+                coefficients.setdefault(name, np.zeros((batch, m)))
+            elif name in coefficients:
+                raise InvalidProblem(f"coefficient {name!r} without a tangential Jacobian Wt")
         set_(self, "coefficients", coefficients)
-        smallest = self._factor_mass()
-        # The criterion of `ImpactProblem`: a normal Delassus entry at rounding level against
-        # the largest inverse mass times the largest squared column of Wn.
+        self._check_normals(self._factor_mass())
+
+    def _check_normals(self, smallest: np.ndarray) -> None:
+        """Refuse a contact no motion moves along its normal, by `ImpactProblem`'s criterion.
+
+        A normal Delassus entry at rounding level against the largest inverse mass (1 over
+        ``smallest``, each M's smallest eigenvalue) times the largest squared column of the
+        whole Jacobian ``[Wn, Wt]``.
+        """
         diagonal = np.einsum("kjj->kj", self.delassus)
-        inverse_mass = 1.0 / smallest
-        floor = 1e-12 * inverse_mass * np.einsum("kij,kij->kj", self.Wn, self.Wn).max(axis=1)
+        columns = np.einsum("kij,kij->kj", self.Wn, self.Wn).max(axis=1)
+        if self.Wt is not None:
+            columns = np.maximum(columns, np.einsum("kij,kij->kj", self.Wt, self.Wt).max(axis=1))
+        floor = 1e-12 * columns / smallest
         for k, j in np.argwhere(diagonal <= floor[:, None])[:1]:
             raise InvalidProblem(
                 f"problem {k}: contacts[{j}]: no motion moves it along its normal "
@@ -169,7 +214,11 @@ class ProblemBatch:
 
     @classmethod
     def from_problems(cls, problems: Sequence[ImpactProblem]) -> ProblemBatch:
-        """Stack problems of one shape (frictionless, zero gaps)."""
+        """Stack problems of one shape (n, m and d alike, zero gaps), checked as a batch.
+
+        An override of ``e`` that some contacts give and others do not is carried as the
+        coefficient of its kind at every contact (`Contact.restitution`).
+        """
         if not problems:
             raise InvalidProblem("an empty batch: give at least one problem")
         for k, problem in enumerate(problems):
@@ -177,26 +226,30 @@ class ProblemBatch:
                 raise TypeError(f"problems[{k}] is {type(problem).__name__}, not ImpactProblem")
         first = problems[0]
         for k, problem in enumerate(problems):
-            if (problem.n, problem.m) != (first.n, first.m):
+            if (problem.n, problem.m, problem.d) != (first.n, first.m, first.d):
                 raise InvalidProblem(
-                    f"problem {k} has (n, m) = ({problem.n}, {problem.m}), problem 0 has "
-                    f"({first.n}, {first.m}): a batch holds problems of one shape"
+                    f"problem {k} has (n, m, d) = ({problem.n}, {problem.m}, {problem.d}), "
+                    f"problem 0 has ({first.n}, {first.m}, {first.d}): a batch holds problems "
+                    "of one shape"
                 )
-            if problem.Wt is not None or problem.gaps.any():
-                raise InvalidProblem(
-                    f"problem {k} has a tangential Jacobian or gaps: a batch is frictionless "
-                    "and simultaneous"
-                )
+            if problem.gaps.any():
+                raise InvalidProblem(f"problem {k} has gaps: a batch is simultaneous")
+        contacts = [p.contacts for p in problems]
         coefficients = {
-            name: np.array([[getattr(c, name) for c in p.contacts] for p in problems])
-            for name in COEFFICIENTS
-            if all(getattr(c, name) is not None for p in problems for c in p.contacts)
+            name: np.array([[c.restitution(kind) for c in row] for row in contacts])
+            for kind, name in RESTITUTION_FIELDS.items()
+            if any(getattr(c, name) is not None for row in contacts for c in row)
         }
+        names = ("e", *FRICTION_COEFFICIENTS) if first.Wt is not None else ("e",)
+        for name in names:
+            coefficients[name] = np.array([[getattr(c, name) for c in row] for row in contacts])
+        Wt = None if first.Wt is None else np.stack([p.Wt for p in problems])
         return cls(
             np.stack([p.M for p in problems]),
             np.stack([p.Wn for p in problems]),
             np.stack([p.v for p in problems]),
             coefficients,
+            Wt,
         )
 
     def __len__(self) -> int:
@@ -221,16 +274,54 @@ class ProblemBatch:
             return np.einsum("kij,kj->ki", self._inverse, rhs)
         return self._inverse @ rhs
 
+    @property
+    def d(self) -> int:
+        """Tangential directions per contact: 0 without ``Wt``, 1 planar, 2 spatial."""
+        return 0 if self.Wt is None else self.Wt.shape[2] // self.m
+
     @cached_property
-    def delassus(self) -> np.ndarray:
-        """Normal Delassus matrices ``Wn.T M^-1 Wn``, (B, m, m)."""
+    def mu(self) -> np.ndarray:
+        """Coulomb coefficients (B, m); zeros without a tangential Jacobian."""
+        return self.coefficients.get("mu", np.zeros((len(self.v), self.m)))
+
+    @cached_property
+    def frictional(self) -> bool:
+        """Whether some problem has a tangential Jacobian and a positive mu.
+
+        With `d` and `closed_count`, what a law's `Tags.refusal` reads of a problem: a law's
+        tags judge a batch as they judge each of its problems.
+        """
+        return self.Wt is not None and bool((self.mu > 0).any())
+
+    @property
+    def closed_count(self) -> int:
+        """Closed contacts of every problem: all of them (a batch has no gaps)."""
+        return self.m
+
+    def _symmetric_product(self, W: np.ndarray) -> np.ndarray:
+        """``W.T M^-1 W`` for every problem, symmetrized, (B, k, k) for ``W`` (B, n, k)."""
         reciprocal = self.__dict__.get("_inverse_diagonal")
         if reciprocal is not None:
             # One pass over the entries instead of a stack of small matrix products.
-            G = np.einsum("kij,ki,kil->kjl", self.Wn, reciprocal, self.Wn)
+            G = np.einsum("kij,ki,kil->kjl", W, reciprocal, W)
         else:
-            G = np.swapaxes(self.Wn, 1, 2) @ self.solve_mass(self.Wn)
+            G = np.swapaxes(W, 1, 2) @ self.solve_mass(W)
         return (G + np.swapaxes(G, 1, 2)) / 2
+
+    @cached_property
+    def delassus(self) -> np.ndarray:
+        """Normal Delassus matrices ``Wn.T M^-1 Wn``, (B, m, m)."""
+        return self._symmetric_product(self.Wn)
+
+    @cached_property
+    def W(self) -> np.ndarray:
+        """Contact Jacobians ``[Wn, Wt]`` (B, n, m + m*d): normal columns, then tangential."""
+        return self.Wn if self.Wt is None else np.concatenate([self.Wn, self.Wt], axis=2)
+
+    @cached_property
+    def contact_delassus(self) -> np.ndarray:
+        """``W.T M^-1 W`` (B, m + m*d, m + m*d), in `ImpactProblem.contact_delassus`' order."""
+        return self.delassus if self.Wt is None else self._symmetric_product(self.W)
 
     @cached_property
     def in_own_units(self) -> bool:
@@ -250,6 +341,13 @@ class ProblemBatch:
     def un(self) -> np.ndarray:
         """Pre-impact gap rates ``Wn.T @ v``, (B, m)."""
         return np.einsum("knm,kn->km", self.Wn, self.v)
+
+    @cached_property
+    def ut(self) -> np.ndarray:
+        """Pre-impact slip velocities ``Wt.T @ v``, (B, m*d); (B, 0) without ``Wt``."""
+        if self.Wt is None:
+            return np.zeros((len(self), 0))
+        return np.einsum("knm,kn->km", self.Wt, self.v)
 
     def restitution(self, kind: str) -> np.ndarray:
         """Per-problem, per-contact coefficients of ``kind`` (the override where given), (B, m)."""
@@ -274,7 +372,8 @@ class ProblemBatch:
             )
             for j in range(self.m)
         ]
-        return ImpactProblem(self.M[k], self.Wn[k], self.v[k], contacts)
+        Wt = None if self.Wt is None else self.Wt[k]
+        return ImpactProblem(self.M[k], self.Wn[k], self.v[k], contacts, Wt)
 
 
 @dataclass(frozen=True, eq=False)
@@ -288,6 +387,8 @@ class OutcomeBatch:
     T_minus, T_plus : array (B,)
     diagnostics : dict
         ``formulation`` (the vectorized method, or 'one by one'), ``options``, ``wall_time_s``.
+    Pt : array (B, m*d)
+        Tangential impulses; (B, 0) without a tangential Jacobian (the default).
     """
 
     v_plus: np.ndarray
@@ -295,17 +396,33 @@ class OutcomeBatch:
     T_minus: np.ndarray
     T_plus: np.ndarray
     diagnostics: dict[str, Any] = field(default_factory=dict)
+    Pt: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.Pt is None:
+            object.__setattr__(self, "Pt", np.zeros((len(self.v_plus), 0)))
 
     @classmethod
-    def from_impulses(cls, batch: ProblemBatch, Pn: np.ndarray, **diagnostics: Any) -> OutcomeBatch:
-        """Apply impulses ``Pn`` (B, m) to every problem of ``batch``."""
-        v_plus = batch.v + batch.solve_mass(np.einsum("knm,km->kn", batch.Wn, Pn))
+    def from_impulses(
+        cls, batch: ProblemBatch, Pn: np.ndarray, Pt: np.ndarray | None = None, **diagnostics: Any
+    ) -> OutcomeBatch:
+        """Apply impulses ``Pn`` (B, m) and ``Pt`` (B, m*d) to every problem of ``batch``.
+
+        ``Pt`` None gives no tangential impulse: (B, m*d) zeros for a batch with ``Wt``.
+        """
+        impulse = np.einsum("knm,km->kn", batch.Wn, Pn)
+        if Pt is None:
+            Pt = np.zeros((len(batch), batch.m * batch.d))
+        elif batch.d:
+            impulse += np.einsum("knm,km->kn", batch.Wt, Pt)
+        v_plus = batch.v + batch.solve_mass(impulse)
         return cls(
             v_plus,
             Pn,
             batch.kinetic_energy(batch.v),
             batch.kinetic_energy(v_plus),
             dict(diagnostics),
+            Pt,
         )
 
     @property
@@ -317,10 +434,14 @@ class OutcomeBatch:
         return self.v_plus.shape[0]
 
     def to_frame(self) -> pd.DataFrame:
-        """One row per problem: ``v_plus_i``, ``Pn_j``, ``T_minus``, ``T_plus``, ``dT``."""
+        """One row per problem: ``v_plus_i``, ``Pn_j``, ``Pt_j``, ``T_minus``, ``T_plus``, ``dT``.
+
+        ``Pt_j`` is the j-th tangential impulse (contact ``j // d``); none without friction.
+        """
         import pandas as pd
 
         columns = {f"v_plus_{i}": self.v_plus[:, i] for i in range(self.v_plus.shape[1])}
         columns |= {f"Pn_{j}": self.Pn[:, j] for j in range(self.Pn.shape[1])}
+        columns |= {f"Pt_{j}": self.Pt[:, j] for j in range(self.Pt.shape[1])}
         columns |= {"T_minus": self.T_minus, "T_plus": self.T_plus, "dT": self.dT}
         return pd.DataFrame(columns)

@@ -248,8 +248,11 @@ class Law(ABC):
         """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
         return self.separating_rule
 
-    def refusal(self, problem: ImpactProblem) -> str | None:
-        """Why this law cannot treat ``problem`` (a feature its tags do not cover), or None."""
+    def refusal(self, problem: ImpactProblem | ProblemBatch) -> str | None:
+        """Why this law cannot treat ``problem`` (a feature its tags do not cover), or None.
+
+        A batch is refused for what its problems share (friction, spatial rows, contacts).
+        """
         tags = self.tags
         if problem.frictional and not tags.friction:
             return "the problem has friction (mu > 0) and this law is frictionless"
@@ -438,43 +441,78 @@ class Law(ABC):
         Returns
         -------
         OutcomeBatch
-            Equal to resolving each problem with `resolve`, to rounding.
+            Equal to resolving each problem with `resolve`, to rounding;
+            ``diagnostics['one_by_one']`` counts the problems the vectorized path left to
+            `resolve`.
 
         Raises
         ------
         InvalidProblem, NotApplicable, SolverFailure
-            As `resolve`; one by one, the first problem that raises stops the batch.
+            As `resolve`: the law's refusal for the whole batch; one by one, the first problem
+            that raises stops the batch.
         """
-        from lawbench.core.batch import OutcomeBatch  # on first use: a single solve needs no batch
-
         values = self.option_values(options)
+        reason = self.refusal(batch)
+        if reason:
+            raise NotApplicable(f"{self.name}: {reason}")
+        batch = _batch_without_negligible_friction(batch)
         # Problems of extreme scale are rescaled one by one, by `resolve`.
         scaled = self.scale_free and not batch.in_own_units
         with _Watch(self.name, values) as watch:
-            Pn = None if scaled else self._resolve_batch(batch, values)
-            if Pn is not None:
-                result = OutcomeBatch.from_impulses(batch, Pn[0], formulation=Pn[1])
-            else:
-                outcomes = [self.resolve(batch.problem(k), **values) for k in range(len(batch))]
-                result = OutcomeBatch(
-                    np.stack([o.v_plus for o in outcomes]),
-                    np.stack([o.Pn for o in outcomes]),
-                    np.array([o.T_minus for o in outcomes]),
-                    np.array([o.T_plus for o in outcomes]),
-                    {"formulation": "one by one"},
-                )
+            answer = None if scaled else self._resolve_batch(batch, values)
+            result = self._completed(batch, answer, values)
         _refuse_non_finite(self.name, v_plus=result.v_plus)
         result.diagnostics.update(watch.record)
+        return result
+
+    def _completed(
+        self,
+        batch: ProblemBatch,
+        answer: tuple[np.ndarray, str] | None,
+        options: dict[str, Any],
+    ) -> OutcomeBatch:
+        """The outcomes of ``answer``'s impulses, and `resolve`'s for the problems it left."""
+        from lawbench.core.batch import OutcomeBatch  # on first use: a single solve needs no batch
+
+        size, m = len(batch), batch.m
+        if answer is None:
+            P, formulation = np.full((size, m + m * batch.d), np.nan), "one by one"
+        else:
+            P, formulation = answer
+        alone = np.flatnonzero(np.isnan(P).any(axis=1))
+        if alone.size == size:
+            formulation = "one by one"
+        result = OutcomeBatch.from_impulses(
+            batch, P[:, :m], P[:, m:] if P.shape[1] > m else None, formulation=formulation
+        )
+        for k in alone:
+            outcome = self.resolve(batch.problem(k), **options)
+            result.v_plus[k], result.Pn[k], result.Pt[k] = outcome.v_plus, outcome.Pn, outcome.Pt
+            result.T_minus[k], result.T_plus[k] = outcome.T_minus, outcome.T_plus
+        result.diagnostics["one_by_one"] = int(alone.size)
         return result
 
     def _resolve_batch(
         self, batch: ProblemBatch, options: dict[str, Any]
     ) -> tuple[np.ndarray, str] | None:
-        """The impulses (B, m) of every problem and the formulation, or None to go one by one.
+        """The impulses of every problem and the formulation, or None to go one by one.
 
-        A law with a vectorized path overrides this; it must give the answer of `_resolve`.
+        The impulses are (B, m), normal only, or (B, m + m*d), normal then tangential in
+        `ProblemBatch.contact_delassus`' order; a row of NaN leaves its problem to `resolve`
+        (an ambiguous or refused one, whose answer or reason is the one-by-one path's). A law
+        with a vectorized path overrides this; it must give the answer of `_resolve`.
         """
         return None
+
+
+def _batch_without_negligible_friction(batch: ProblemBatch) -> ProblemBatch:
+    """``batch`` with every mu below `NEGLIGIBLE_MU` set to 0, as `resolve` treats them."""
+    mu = batch.mu
+    negligible = (mu > 0) & (mu < NEGLIGIBLE_MU)
+    if not negligible.any():
+        return batch
+    coefficients = {**batch.coefficients, "mu": np.where(negligible, 0.0, mu)}
+    return dataclasses.replace(batch, coefficients=coefficients)
 
 
 def _without_negligible_friction(problem: ImpactProblem) -> tuple[ImpactProblem, list[int]]:

@@ -56,7 +56,7 @@ normal work) and ``v`` (k, n) along the impact.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -67,12 +67,16 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.laws._claims import keeps_energy, never_creates_energy
+from lawbench.laws.darboux_keller import batch as batch_phases
 from lawbench.laws.darboux_keller.dynamics import (
     ImpactRecord,
     SingleContactImpact,
     State,
     path_arrays,
 )
+
+if TYPE_CHECKING:
+    from lawbench.core.batch import ProblemBatch
 
 # Each termination reads the contact's coefficient of its own kind.
 COEFFICIENT = {"newton": "kinematic", "poisson": "kinetic", "energetic": "energetic"}
@@ -168,6 +172,25 @@ class DarbouxKeller(Law):
             diagnostics=diagnostics,
             path=path,
         )
+
+    def _resolve_batch(
+        self, batch: ProblemBatch, options: dict[str, Any]
+    ) -> tuple[np.ndarray, str] | None:
+        """The exact piecewise phases of every impact at once (`batch.impulses`).
+
+        Planar and frictionless impacts; spatial ones with friction, whose slip may turn, and
+        those the phases refuse, are left to `_resolve`.
+        """
+        termination = options["termination"]
+        u_minus = np.concatenate([batch.un, batch.ut], axis=1)
+        P = batch_phases.impulses(
+            batch.contact_delassus,
+            u_minus,
+            batch.mu[:, 0],
+            termination,
+            batch.restitution(COEFFICIENT[termination])[:, 0],
+        )
+        return P, "exact piecewise (batch)"
 
 
 def _path(problem: ImpactProblem, record: ImpactRecord) -> dict[str, np.ndarray]:
