@@ -32,7 +32,7 @@ from lawbench.core.metric import (
     kinetic_energy,
     read_only_finite,
 )
-from lawbench.core.units import solving_units, stiffness_in_units
+from lawbench.core.units import in_units, solving_units
 
 # The kinds of restitution coefficient and the contact field that overrides ``e`` for each:
 # Newton's kinematic, Poisson's kinetic, Stronge's energetic coefficient.
@@ -541,36 +541,9 @@ class ImpactProblem:
     def in_units(self, mass: float, velocity: float, time: float) -> ImpactProblem:
         """The problem with masses, velocities and times in units ``mass``, ``velocity``, ``time``.
 
-        Lengths are then in units of ``velocity time``: M and v are divided by their units,
-        gaps by the length unit, and a stiffness (N/m^exponent = kg m^(1 - exponent) s^-2) is
-        multiplied by ``length^(exponent - 1) time^2 / mass``. A damping's unit depends on the
-        compliant model that reads it, so it is kept as given: the laws that read it solve in
-        the problem's own units (`lawbench.core.law.Law.scale_free`).
-
-        Raises
-        ------
-        InvalidProblem
-            When a number rescaled leaves double precision, naming it and the units.
+        See `lawbench.core.units.in_units`.
         """
-        length = velocity * time
-        contacts, rescaled = [], {}
-        for contact in self.contacts:
-            if contact not in rescaled:
-                stiffness = stiffness_in_units(
-                    contact.stiffness, contact.exponent, mass, length, time
-                )
-                rescaled[contact] = dataclasses.replace(contact, stiffness=stiffness)
-            contacts.append(rescaled[contact])
-        gaps = self.gaps / length if self.gaps.any() else None
-        try:
-            return dataclasses.replace(
-                self, M=self.M / mass, v=self.v / velocity, contacts=contacts, gaps=gaps
-            )
-        except (InvalidProblem, OverflowError) as exc:
-            raise InvalidProblem(
-                f"in units of {mass:g} kg, {velocity:g} m/s and {time:g} s the problem cannot "
-                f"be solved: {exc}"
-            ) from None
+        return in_units(self, mass, velocity, time)
 
     def select_contacts(self, mask: np.ndarray) -> ImpactProblem:
         """Return the problem restricted to the contacts where ``mask`` is true."""

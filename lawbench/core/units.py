@@ -3,18 +3,22 @@
 A scale-free law (`lawbench.core.law.Law.scale_free`) solves a problem in units where its
 heaviest mass and fastest speed are near 1, so that masses of 1e-308 kg or speeds of 1e-300 m/s
 neither under- nor overflow in its linear algebra and integrators. The units are powers of two:
-rescaling by them rounds nothing. `lawbench.core.problem.ImpactProblem.in_units` rescales.
+rescaling by them rounds nothing. `in_units` rescales a problem.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lawbench.core.errors import InvalidProblem
+
+if TYPE_CHECKING:
+    from lawbench.core.problem import ImpactProblem
 
 # A problem whose heaviest mass entry and fastest velocity component lie within this factor of
 # 1 (about 1e-9 to 1e9) is solved in its own units; beyond, in units near them.
@@ -86,3 +90,36 @@ def stiffness_in_units(
     """
     factor_log = (exponent - 1.0) * math.log2(length) + 2.0 * math.log2(time) - math.log2(mass)
     return 2.0 ** (math.log2(stiffness) + factor_log)
+
+
+def in_units(problem: ImpactProblem, mass: float, velocity: float, time: float) -> ImpactProblem:
+    """``problem`` with masses, velocities and times in units ``mass``, ``velocity``, ``time``.
+
+    Lengths are then in units of ``velocity time``: M and v are divided by their units,
+    gaps by the length unit, and a stiffness (N/m^exponent = kg m^(1 - exponent) s^-2) is
+    multiplied by ``length^(exponent - 1) time^2 / mass``. A damping's unit depends on the
+    compliant model that reads it, so it is kept as given: the laws that read it solve in
+    the problem's own units (`lawbench.core.law.Law.scale_free`).
+
+    Raises
+    ------
+    InvalidProblem
+        When a number rescaled leaves double precision, naming it and the units.
+    """
+    length = velocity * time
+    contacts, rescaled = [], {}
+    for contact in problem.contacts:
+        if contact not in rescaled:
+            stiffness = stiffness_in_units(contact.stiffness, contact.exponent, mass, length, time)
+            rescaled[contact] = dataclasses.replace(contact, stiffness=stiffness)
+        contacts.append(rescaled[contact])
+    gaps = problem.gaps / length if problem.gaps.any() else None
+    try:
+        return dataclasses.replace(
+            problem, M=problem.M / mass, v=problem.v / velocity, contacts=contacts, gaps=gaps
+        )
+    except (InvalidProblem, OverflowError) as exc:
+        raise InvalidProblem(
+            f"in units of {mass:g} kg, {velocity:g} m/s and {time:g} s the problem cannot "
+            f"be solved: {exc}"
+        ) from None
