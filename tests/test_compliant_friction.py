@@ -116,3 +116,58 @@ def test_a_grazing_slip_costs_no_more_steps_than_a_steep_one(e):
         mu = problem.contacts[0].mu
         np.testing.assert_allclose(np.abs(outcome.Pt), mu * outcome.Pn, rtol=1e-9)
     assert steps[1e-12] <= 2 * steps[1e-4]
+
+
+def cube_corner(ratio):
+    """Toss 50's first impact in the ContactNets cube set: one corner on the table, z up.
+
+    A cube of 0.37 kg and side 0.1048 m (Pfrommer, Halm and Posa, CoRL 2020), the corner at
+    ``r`` from its centre, coordinates ``(v_centre, omega)``; each Jacobian column is
+    ``(e, r x e)``, as the set builds it, with e = 0.35, mu = 0.25, stiffness 1e6 and the
+    tangential stiffness ratio ``ratio``.
+    """
+    r = np.array([0.00629, 0.00859, -0.0901])
+    M = np.diag([0.37] * 3 + [6.773e-4] * 3)
+    Wn, tx, ty = (np.concatenate([axis, np.cross(r, axis)]) for axis in np.eye(3)[[2, 0, 1]])
+    v = np.array([0.398, -0.963, -1.044, 4.691, 2.156, -0.539])
+    return lawbench.ImpactProblem.from_arrays(
+        M,
+        Wn[:, None],
+        v,
+        np.column_stack([tx, ty]),
+        e=0.35,
+        mu=0.25,
+        stiffness=1e6,
+        tangential_stiffness_ratio=ratio,
+    )
+
+
+@pytest.mark.parametrize("ratio", [0.25, 0.1])
+def test_a_slip_stopping_on_an_unloading_cone_hands_back_to_its_stretch(ratio):
+    """A stiff tangential spring keeps the cube corner's cone narrow, where a 3D slip follows
+    its velocity. As the contact unloads, the cone shrinks and the slip slows to a stop: the
+    friction force along the slip velocity would turn over at once there, so the slip hands
+    back to the spring and slider first. The impact ends in a few hundred steps (it ran out of
+    its 60 s budget chattering about zero slip), creates no energy, keeps the friction in its
+    cone and the momentum the contact cannot change."""
+    trial = lawbench.evaluate("compliant", cube_corner(ratio), {"tol": 1e-6})
+    assert trial.outcome.diagnostics["steps"] <= 1500
+    checks = lawbench.run_checks(trial, checks=["energy_gain", "friction_cone", "momentum"])
+    assert {name: str(result.verdict) for name, result in checks.items()} == {
+        "energy_gain": "holds",
+        "friction_cone": "holds",
+        "momentum": "holds",
+    }
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ratio", [0.05, 0.1, 0.25, 0.5, 2.0, 10.0])
+def test_the_cube_corner_converges_with_tol_at_every_tangential_stiffness(ratio):
+    """Across the tangential stiffness ratios a fit may try, the answer at tol is within tol
+    (relative to the largest pre-impact velocity) of the answer at tol = 1e-11: the slip
+    follows its velocity only where the stretch's lag is below tol^(1/2)."""
+    problem = cube_corner(ratio)
+    reference = lawbench.solve("compliant", problem, {"tol": 1e-11}).v_plus
+    for tol in (1e-6, 1e-8):
+        outcome = lawbench.solve("compliant", problem, {"tol": tol})
+        assert relative(outcome.v_plus, reference, problem.v) <= tol

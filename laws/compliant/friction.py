@@ -47,6 +47,22 @@ with spatial friction ``method='auto'`` takes LSODA, which turns to implicit ste
 is stiff (that shot in 1.8 s; elsewhere about twice DOP853's time, within 1e-9 of it at tol = 1e-10;
 at tol it lost 3.4e-9 of an elastic head-on impact's energy where DOP853 loses 1.6e-10, so it runs
 at tol / 10, which brings that to 4.3e-10).
+
+The slip follows its velocity only while the stretch's lag is small. Under a friction force on a
+cone of radius ``r`` the slip velocity turns at about ``w^2 r / |ut|`` (``w`` the tangential
+spring's angular frequency on the contact's effective tangential mass, the largest over its
+tangential directions), and the stretch takes ``r / |ut|`` to follow it: it lags by the angle
+``(w r / |ut|)^2``, and the slip follows its velocity only where that angle is below the same
+``tol^(1/2)``. So a slip that slows down hands back to the stretch before it stops. A force along
+the slip velocity turns over at once where the slip reverses, and on a cone that shrinks as the
+contact unloads the slip speed ``lam = |ut| - r'`` never falls to zero: without the hand-over the
+integration chattered about zero slip in steps of 1e-10 of the contact time, and the dropped lag
+cost accuracy. A corner of the ContactNets cube (e = 0.35, mu = 0.25, stiffness 1e6) ran out of
+its 60 s at ``tangential_stiffness_ratio`` 0.25 and below at tol = 1e-6, 0.1 and below at
+1e-8, 0.5 at 1e-4 (the stiffer the tangential spring, the narrower its cone), and lost 1e-4 of
+its spin at ratio 0.25 and tol = 1e-8. Now it is answered at every ratio from 0.02 to 10, within
+1e-7 of its tol = 1e-12 answer at tol = 1e-6 and within 2e-9 at tol = 1e-8 (velocities relative
+to the largest pre-impact one); the scenes above keep their steps.
 """
 
 from __future__ import annotations
@@ -99,6 +115,10 @@ class FrictionalIntegration(Integration):
         # Newtons per scaled stretch, and scaled cone radius per newton of normal force.
         self.kt_scaled = self.kt * self.L
         self.cone = self.mu / self.kt_scaled
+        # Each tangential spring's angular frequency in scaled time, on the contact's stiffest
+        # tangential direction (its largest diagonal entry of the Delassus matrix).
+        tangential = np.diagonal(self.Gc)[problem.m :].reshape(problem.m, self.d)
+        self.frequency = np.sqrt(self.scale * self.kt_scaled * tangential.max(axis=1))
         self.short = min(options["tol"], LOOSEST_SHORT) ** SHORT_POWER if self.d > 1 else 0.0
         m, md = problem.m, problem.m * self.d
         bounds = np.cumsum([0, m, md, m, md])
@@ -187,6 +207,19 @@ class FrictionalIntegration(Integration):
         at = self.field(y, closed, np.zeros(self.problem.m, dtype=bool))
         return self.mu[j] > 0 and float(np.linalg.norm(ut[j])) > at["cone_rate"][j]
 
+    def follow_margin(self, y: np.ndarray, radius: np.ndarray) -> np.ndarray:
+        """Positive where a 3D slip may follow its velocity, zero where it switches.
+
+        ``y`` is a scaled state (or states stacked, see `split`) and ``radius`` its cones'
+        radii. The slip follows its velocity on a cone narrower than ``short`` while its
+        stretch's lag angle ``(frequency r / |ut|)^2`` is below ``short``: the margin is the
+        smaller of ``short - r`` and ``short^(1/2) |ut| - frequency r``, continuous in ``y``.
+        """
+        ut = self.split(y)[3]
+        speed = np.sqrt(np.einsum("...jd,...jd->...j", ut, ut))
+        lag = self.short**0.5 * speed - self.frequency * radius
+        return np.minimum(self.short - radius, lag)
+
     def on_cones(
         self, y: np.ndarray, closed: np.ndarray, slipping: np.ndarray, aligned: np.ndarray
     ) -> np.ndarray:
@@ -246,8 +279,9 @@ class FrictionalIntegration(Integration):
             for j in np.flatnonzero(closed & ~was_closed):
                 slipping[j] = self.closing_slides(y, closed, j)
             self.slips += int((slipping & ~was_closed).sum())
-            # A 3D slip on a cone narrower than ``short`` follows the slip velocity.
-            narrow = slipping & (self.field(y, closed, slipping)["radius"] < self.short)
+            # A fast 3D slip on a cone narrower than ``short`` follows the slip velocity.
+            radius = self.field(y, closed, slipping)["radius"]
+            narrow = slipping & (self.follow_margin(y, radius) > 0)
             y = self.on_cones(y, closed, slipping, narrow | following)
             # A stretch met on its cone where its slip would run backward (lam < 0: within
             # rounding of a slip that just stopped) sticks; sliding there would feed the slip.
@@ -330,16 +364,16 @@ class _Mode:
         self.damped = integration.clipped and bool(integration.c[closed].any())
         self.plastic = closed & integration.plastic
         # A gap fires as it passes its band away from its side; a stretch reaching the cone and
-        # a slip speed falling to zero fire as they fall below zero; a 3D cone widening past
-        # or narrowing below ``short`` as it crosses it; a plastic contact's gap rate as it
-        # turns from approach to separation.
+        # a slip speed falling to zero fire as they fall below zero; a 3D slip's follow margin
+        # as it leaves the side it started on; a plastic contact's gap rate as it turns from
+        # approach to separation.
         gaps = np.where(closed, 1.0, -1.0)
         m = closed.size
         self.direction = np.concatenate(
             [
                 gaps,
                 -np.ones(2 * m),
-                np.where(following, 1.0, -1.0),
+                np.where(following, -1.0, 1.0),
                 np.ones(m),
                 np.zeros(m) if self.damped else np.zeros(0),
             ]
@@ -358,7 +392,7 @@ class _Mode:
             g + integration.band,
             np.where(self.sticking, at["radius"] - at["size"], 1.0),
             np.where(self.slipping, at["lam"], 1.0),
-            np.where(narrow, at["radius"] - integration.short, 1.0),
+            np.where(narrow, integration.follow_margin(y, at["radius"]), -1.0),
             np.where(self.plastic, un, -1.0),
         ]
         if self.damped:
