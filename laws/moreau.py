@@ -82,12 +82,13 @@ frictionless formulations above do not depend on it:
 - ``auto`` (default): the fixed point on an impact of at most ``FIXED_POINT_MAX`` (8) contacts,
   every scene's, where a cone QP costs milliseconds and settles the cases of several solutions;
   Gauss-Seidel with the polish above on a larger impact and in contact space, then the fixed
-  point where the sweeps become stationary above ``tol``. This follows Acary, Brémond and
-  Huber's comparison of FC3D solvers (NSGS with an exact local solver the robust choice on the
-  large problems of FCLIB, interior-point and Newton methods on small ones) and Siconos, whose
-  frictional problems default to its NSGS: the fixed point alone spends over a minute on 286
-  capsules that 3050 sweeps solve in 2 s. Anitescu's relaxation is the fixed point's.
-  Diagnostics name the ``method`` that answered and, under ``after``, the failure it followed.
+  point where the sweeps become stationary above ``tol`` or run out of their bound. This
+  follows Acary, Brémond and Huber's comparison of FC3D solvers (NSGS with an exact local
+  solver the robust choice on FCLIB's large problems, interior-point and Newton methods on
+  small ones) and Siconos, whose frictional problems default to its NSGS: the fixed point
+  alone spends over a minute on 286 capsules that 3050 sweeps solve in 2 s. Anitescu's
+  relaxation is the fixed point's. Diagnostics name the ``method`` that answered and, under
+  ``after``, the failures it followed.
 
 Option ``max_steps`` bounds each method's steps, cone QPs or sweeps; at its default 0 the
 problem's size sets them: ``FIXED_POINT_STEPS`` (1000) cone QPs, and ``SWEEPS_PER_CONTACT``
@@ -226,8 +227,8 @@ class Moreau(Law):
             "the solver of the frictional problem: fixed point over cone QPs (clarabel), "
             "nonsmooth Gauss-Seidel with an exact solver per contact, or auto: the fixed point "
             f"up to {FIXED_POINT_MAX} contacts of an impact, Gauss-Seidel beyond and in contact "
-            "space with the fixed point where its sweeps stall (Acary, Bremond and Huber 2018; "
-            "Siconos' default solver is NSGS)",
+            "space, then the fixed point where the sweeps stall or run out (Acary, Bremond and "
+            "Huber 2018; Siconos' default solver is NSGS)",
             kind="str",
             choices=("auto", "fixed_point", "nsgs"),
         ),
@@ -314,7 +315,7 @@ class Moreau(Law):
 
         ``nsgs`` sweeps ``W`` itself; the fixed point's cone QPs take ``W``'s symmetric part and
         iterate its rest with the friction term (`_contact_fixed_point`); ``auto`` sweeps first
-        and hands a stationary iteration to the fixed point (`_methods`). Each answers to an
+        and hands sweeps that stall or run out to the fixed point (`_methods`). Each answers to an
         FC3D error of at most ``tol``, the measure of a contact-space problem, or fails saying
         where it stopped.
         """
@@ -350,8 +351,8 @@ def _methods(options: dict[str, Any], m: int, in_contact_space: bool) -> tuple[s
 
     An explicit ``method`` alone. ``auto``: the fixed point for Anitescu's relaxation (one cone
     QP) and for an impact of at most `FIXED_POINT_MAX` contacts; otherwise Gauss-Seidel, then
-    the fixed point where its sweeps become stationary above ``tol`` (on a singular Delassus
-    matrix, where the fixed point's interior-point steps still find the contact states).
+    the fixed point where the sweeps become stationary above ``tol`` or run out of their bound
+    (on a singular Delassus matrix, whose contact states the interior-point steps still find).
     """
     method = options["method"]
     if method != "auto":

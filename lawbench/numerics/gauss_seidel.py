@@ -37,7 +37,9 @@ costs about as much as a sweep, so, like Siconos' light-then-full evaluation, it
 when the relative change of ``P`` over a sweep falls below a gate (``tol`` at first, lowered by
 the ratio of the error found to ``tol``), and every `CHECK_EVERY` sweeps. Each sweep spends one
 step of the solve's budget (`lawbench.core.law`), so the loop ends at the law's ``max_steps``
-or ``max_seconds``.
+or ``max_seconds``. `solve_polished` is the law's solve: the sweeps, then, where they became
+stationary above ``tol``, Newton's method on the contact states they show
+(`lawbench.numerics.cones.polish`), or a failure that gives ``W``'s rank.
 
 The per-contact kernel and the sweep are compiled by numba at the first solve where it is
 installed (``pip install 'lawbench[fast]'``, `compiled`); the same functions run as plain
