@@ -37,7 +37,9 @@ costs about as much as a sweep, so, like Siconos' light-then-full evaluation, it
 when the relative change of ``P`` over a sweep falls below a gate (``tol`` at first, lowered by
 the ratio of the error found to ``tol``), and every `CHECK_EVERY` sweeps. Each sweep spends one
 step of the solve's budget (`lawbench.core.law`), so the loop ends at the law's ``max_steps``
-or ``max_seconds``.
+or ``max_seconds``. `solve_polished` is the law's solve: the sweeps, then, where they became
+stationary above ``tol``, Newton's method on the contact states they show
+(`lawbench.numerics.cones.polish`), or a failure that gives ``W``'s rank.
 
 The per-contact kernel and the sweep are compiled by numba at the first solve where it is
 installed (``pip install 'lawbench[fast]'``, `compiled`); the same functions run as plain
@@ -56,8 +58,10 @@ from typing import Any, TypeVar
 import numpy as np
 import scipy.sparse
 
+from lawbench.core.errors import SolverFailure
 from lawbench.core.law import current_budget
 from lawbench.core.mechanics import fc3d_error, project
+from lawbench.numerics import cones
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 # The kernels numba compiles, by their names in this module.
@@ -462,3 +466,65 @@ def solve_nsgs(
             gate = min(gate, light * tol / error)
             note = f"last change of P {light:.3g}, last FC3D error {error:.3g}, tolerance {tol:g}"
     return GaussSeidelResult(P, sweeps, error)
+
+
+def solve_polished(
+    W: Any, q: np.ndarray, mu: np.ndarray, dim: int, tol: float, polish: bool
+) -> tuple[np.ndarray, dict[str, Any]]:
+    """`solve_nsgs` to ``tol``, then `cones.polish` (with ``polish``) where the sweeps stall.
+
+    A polish (dense Newton steps on the contact states) of an answer already within ``tol``
+    would cost more than the sweeps: it is tried only on an iteration that became stationary
+    above ``tol``, and kept where it lowers the FC3D error. Returns the impulses (FCLIB's
+    order) and the diagnostics of a law's answer (formulation, sweeps, polished, FC3D error).
+
+    Raises
+    ------
+    SolverFailure
+        When the sweeps became stationary above ``tol`` and the polish did not reach it.
+    """
+    m = len(mu)
+    result = solve_nsgs(W, q, mu, dim, tol)
+    P, error, polished = result.P, result.error, False
+    if error > tol and polish:
+        back = np.argsort(local_order(m, dim - 1))
+        G, lawbench_q = scipy.sparse.csr_matrix(W)[back][:, back].toarray(), q[back]
+        refined = cones.polish(G, lawbench_q, mu, dim - 1, P[back], True)
+        if refined is not None:
+            refined = refined[local_order(m, dim - 1)]
+            refined_error = fc3d_error(W, q, mu, refined)
+            if refined_error <= error:
+                P, error, polished = refined, refined_error, True
+    if error > tol:
+        raise SolverFailure(
+            f"Gauss-Seidel stationary after {result.sweeps} sweeps at FC3D error {error:.3g}, "
+            f"above the tolerance {tol:g}{_rank_note(W)}"
+        )
+    diagnostics = {
+        "formulation": "NSGS, exact local solver" + (" (numba)" if compiled() else ""),
+        "solver_status": "converged",
+        "iterations": result.sweeps,
+        "sweeps": result.sweeps,
+        "polished": polished,
+        "fc3d_error": error,
+    }
+    return P, diagnostics
+
+
+# The largest Delassus matrix whose rank a failure message states (an SVD, O(n^3)).
+RANK_NOTE_MAX = 2000
+
+
+def _rank_note(W: Any) -> str:
+    """``'; W has rank r of n'`` for a singular Delassus matrix small enough to decompose.
+
+    Gauss-Seidel's sweeps contract only where ``W`` is regular: on a singular one (more contact
+    directions than the bodies' coordinates, as in granular packings) they can settle away
+    from any solution, and the rank says so.
+    """
+    n = W.shape[0]
+    if n > RANK_NOTE_MAX:
+        return ""
+    values = np.linalg.svd(scipy.sparse.csr_matrix(W).toarray(), compute_uv=False)
+    rank = int((values > n * np.finfo(float).eps * values[0]).sum())
+    return f"; W is singular, rank {rank} of {n}" if rank < n else ""
