@@ -79,21 +79,17 @@ frictionless formulations above do not depend on it:
   problems whose Delassus matrix is singular (more contact directions than coordinates), where
   the fixed point's interior-point steps still find the contact states. Diagnostics:
   ``sweeps`` (and ``iterations``, the same), ``polished``, ``fc3d_error``.
-- ``auto`` (default): the fixed point on an impact of at most ``FIXED_POINT_MAX`` (8) contacts,
-  every scene's, where a cone QP costs milliseconds and settles the cases of several solutions;
-  Gauss-Seidel with the polish above on a larger impact and in contact space, then the fixed
-  point where the sweeps become stationary above ``tol`` or run out of their bound. This
-  follows Acary, Brémond and Huber's comparison of FC3D solvers (NSGS with an exact local
-  solver the robust choice on FCLIB's large problems, interior-point and Newton methods on
-  small ones) and Siconos, whose frictional problems default to its NSGS: the fixed point
-  alone spends over a minute on 286 capsules that 3050 sweeps solve in 2 s. Anitescu's
-  relaxation is the fixed point's. Diagnostics name the ``method`` that answered and, under
-  ``after``, the failures it followed.
+- ``auto`` (default): the fixed point on an impact of at most ``FIXED_POINT_MAX`` contacts,
+  where a cone QP is cheap and settles the cases of several solutions; Gauss-Seidel with the
+  polish on a larger impact and in contact space, then the fixed point where the sweeps become
+  stationary above ``tol`` or run out of their bound: Acary, Brémond and Huber's comparison of
+  FC3D solvers (NSGS with an exact local solver the robust choice on FCLIB's large problems)
+  and Siconos' default. Diagnostics name the ``method`` that answered and, under ``after``,
+  the failures it followed.
 
-Option ``max_steps`` bounds each method's steps, cone QPs or sweeps; at its default 0 the
-problem's size sets them: ``FIXED_POINT_STEPS`` (1000) cone QPs, and ``SWEEPS_PER_CONTACT``
-(20) sweeps per contact, at least ``SWEEPS_MIN`` (1000), since a sweep carries information one
-contact further and a granular packing needs about ten per contact.
+Option ``max_steps`` bounds each method's steps; at its default 0 the problem's size sets them:
+``FIXED_POINT_STEPS`` cone QPs, and ``SWEEPS_PER_CONTACT`` sweeps per contact (at least
+``SWEEPS_MIN``), since a sweep carries information one contact further.
 
 In contact space (`Law.solve_contact`: FCLIB's local form, ``W``, ``q`` and ``mu`` as a file
 holds them, the impact with ``e = 0``) every method solves Coulomb's law on ``W`` as given:
