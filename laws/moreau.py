@@ -113,10 +113,9 @@ cone conditions better; an answer clarabel only 'AlmostSolved' must be refined o
 `SolverFailure`. Diagnostics: ``fixed_point_steps`` (cone QPs solved), ``iterations``
 (clarabel's, summed over them), ``solver_status`` (the last one's), ``polished``.
 
-With ``e = 0`` the exact law never creates energy,
-``dT = -sum_j mu_j Pn_j |ut+_j| - P.G P / 2 <= 0``. With ``e > 0`` it can, like Whittaker's law
-(the same law at one contact): on the falling rod and the double pendulum the slip reverses
-and ``-e Pn un-`` outweighs the losses.
+With ``e = 0`` the exact law never creates energy, ``dT = -sum_j mu_j Pn_j |ut+_j| - P.G P / 2``;
+with ``e > 0`` it can, like Whittaker's law (the same law at one contact): on the falling rod
+and the double pendulum the slip reverses and ``-e Pn un-`` outweighs the losses.
 """
 
 from __future__ import annotations
