@@ -15,12 +15,12 @@ noise) and a per-solve budget of `MAX_SECONDS`. A law that fits no friction coef
 refused on impacts measured with friction (a tangential row), and a law's own `NotApplicable`
 refuses an impact; a `SolverFailure` is counted, its impact left out of the errors.
 
-Cost: a fit solves the law some ``FIT_EVALUATIONS * (p + 1)`` times per training impact (``p``
-coefficients). A law whose cost per solve, timed on a few impacts first, would exceed
-`FIT_SECONDS` on the whole training half is fitted on a fixed, evenly spaced subsample of it (at
-least `MIN_IMPACTS`), and judged on one of the test half when it would exceed `JUDGE_SECONDS`;
-the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK` impacts of
-each half, evenly spaced.
+Cost: a fit solves the law tens of times per training impact. A law that integrates the
+impact through time (one that reads the contacts' stiffness, ``tags.stiffness``: tens to
+hundreds of milliseconds a solve, against about one for a closed form) is fitted on a fixed,
+evenly spaced subsample of `COSTLY_FIT` training impacts and judged on `COSTLY_JUDGE` test
+impacts; the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK`
+impacts of each half, evenly spaced, for every law.
 """
 
 from __future__ import annotations
@@ -54,12 +54,9 @@ FIT_TOL = 1e-6
 DIFF_STEP = 1e-3
 # Where each fitted field starts: inside its range, friction moderate, Mindlin's stiffness ratio.
 START = {"e": 0.5, "e_t": 0.0, "mu": 0.2, "tangential_stiffness_ratio": MINDLIN_RATIO}
-# The budget of a law on one set, in seconds of solving, and what a fit costs in evaluations.
-FIT_SECONDS = 60.0
-JUDGE_SECONDS = 20.0
-FIT_EVALUATIONS = 12
-MIN_IMPACTS = 12
-PROBE = 4
+# The impacts a law that integrates in time is fitted and judged on.
+COSTLY_FIT = 16
+COSTLY_JUDGE = 80
 QUICK = 40
 # The ``coefficients`` of a row whose coefficients were fitted on the training impacts.
 FITTED = "fitted"
@@ -203,9 +200,9 @@ def study_options(law: Law) -> dict[str, Any]:
     return law.option_values({**given, "max_seconds": MAX_SECONDS})
 
 
-def evenly(items: Sequence[Any], count: int) -> list[Any]:
-    """``count`` of ``items`` at evenly spaced positions (all of them when fewer)."""
-    if count >= len(items):
+def evenly(items: Sequence[Any], count: int | None) -> list[Any]:
+    """``count`` of ``items`` at evenly spaced positions (all of them when fewer or None)."""
+    if count is None or count >= len(items):
         return list(items)
     return [items[k] for k in np.linspace(0, len(items) - 1, count).round().astype(int)]
 
@@ -316,12 +313,9 @@ def _study_law(
     train, refused_train = _screen(law, halves.train, start)
     test, refused_test = _screen(law, halves.test, start)
     fitted = None
+    fit_count, judge_count = (COSTLY_FIT, COSTLY_JUDGE) if law.tags.stiffness else (None, None)
     if train and test:
-        cost = _probe(law, train, start)
-        per_fit = cost * FIT_EVALUATIONS * (len(free) + 1)
-        fitted, fitted_on, refused_fit = _fit(
-            law, free, start, evenly(train, _count(FIT_SECONDS, per_fit))
-        )
+        fitted, fitted_on, refused_fit = _fit(law, free, start, evenly(train, fit_count))
         refused_train += refused_fit
     if fitted is None:
         row = _row(law.name, FITTED, np.zeros(0), heldout.Errors(*[np.zeros(0)] * 3))
@@ -333,7 +327,7 @@ def _study_law(
             wall_s=time.perf_counter() - started,
         )
         return [(row, pd.DataFrame())]
-    judged = evenly(test, _count(JUDGE_SECONDS, cost))
+    judged = evenly(test, judge_count)
     results = []
     choices = {FITTED: fitted.values}
     choices.update(
@@ -352,19 +346,6 @@ def _study_law(
     for row, _ in results:
         row["wall_s"] = time.perf_counter() - started
     return results
-
-
-def _count(seconds: float, cost: float) -> int:
-    """How many impacts ``seconds`` of solving buys at ``cost`` each (at least `MIN_IMPACTS`)."""
-    return max(MIN_IMPACTS, int(seconds / cost)) if cost > 0 else MIN_IMPACTS
-
-
-def _probe(law: Law, impacts: Sequence[MeasuredImpact], start: Mapping[str, float]) -> float:
-    """The law's wall time per solve at ``start``, timed on `PROBE` evenly spaced impacts."""
-    probe = evenly(impacts, PROBE)
-    began = time.perf_counter()
-    predict(law, probe, start, study_options(law))
-    return (time.perf_counter() - began) / len(probe)
 
 
 def _fit(

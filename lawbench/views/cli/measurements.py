@@ -25,10 +25,11 @@ COMMAND = (
         "processing and self-consistency. With --study, --laws, --quick or --out: fit each "
         "law's contact coefficients (the fields it declares) on the set's training half by "
         "least squares in the kinetic metric, judge it on the test half (relative kinetic "
-        "error: median, 95%% bootstrap interval, interquartile range), beside the published "
+        "error: median, 95% bootstrap interval, interquartile range), beside the published "
         "coefficients and two baselines (a ratio per coordinate, an affine map), and print "
-        "the table ranked by held-out median error. A law too costly for the whole training "
-        "half is fitted on an evenly spaced subsample of it (column fitted_on).",
+        "the table ranked by held-out median error. A law that integrates the impact in time "
+        "is fitted and judged on evenly spaced subsamples of the halves (columns fitted_on, "
+        "judged_on).",
     },
 )
 # The columns the printed table shows of the study's table, with their headers and widths.
