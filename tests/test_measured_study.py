@@ -153,3 +153,16 @@ def test_the_command_refuses_a_bad_name_or_file(tmp_path, capsys):
     assert main(["measurements", "--study"]) == 2
     assert main(["measurements", "kharaz", "--out", str(tmp_path / "t.txt")]) == 2
     assert ".csv or a .parquet" in capsys.readouterr().err
+
+
+def test_the_command_writes_parquet_by_the_suffix(tmp_path, capsys):
+    out = tmp_path / "kharaz.parquet"
+    assert main(["measurements", "kharaz", "--laws", "whittaker", "--out", str(out)]) == 0
+    table = pd.read_parquet(out)
+    assert table["median_error"].is_monotonic_increasing and "whittaker" in set(table["law"])
+
+
+def test_without_a_study_option_the_command_describes_the_set(capsys):
+    assert main(["measurements", "kharaz"]) == 0
+    out = capsys.readouterr().out
+    assert "split:       3 to fit, 3 to judge" in out and "ranked" not in out
