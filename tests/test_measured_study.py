@@ -10,7 +10,7 @@ from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS
 from lawbench.core.problem import CONTACT_RANGES
 from lawbench.fitting import heldout
-from lawbench.fitting.measured import COLUMNS, evenly, measured_study, predict
+from lawbench.fitting.measured import COLUMNS, ranked, evenly, measured_study, predict
 from lawbench.measurements import MEASUREMENTS, MeasurementSet, Processing
 from lawbench.views.cli import main
 
@@ -70,7 +70,7 @@ def test_a_law_fitted_on_ellipse_impacts_beats_the_baselines(thirty):
         assert whittaker["median_error"] < table.loc[(baseline, "fitted"), "median_error"]
     assert ("whittaker", "ICRA 2017") in table.index and ("moreau", "CoRL 2017") in table.index
     assert table.loc[("whittaker", "ICRA 2017"), "mu"] == 0.057
-    assert study.table["median_error"].is_monotonic_increasing
+    assert study.table["common_error"].is_monotonic_increasing and study.common_count == 20
     judged = study.predictions.query("law == 'whittaker' and coefficients == 'fitted'")
     assert len(judged) == 20 and (judged["status"] == "ok").all()
     assert np.median(judged["error"]) == pytest.approx(whittaker["median_error"])
@@ -159,10 +159,30 @@ def test_the_command_writes_parquet_by_the_suffix(tmp_path, capsys):
     out = tmp_path / "kharaz.parquet"
     assert main(["measurements", "kharaz", "--laws", "whittaker", "--out", str(out)]) == 0
     table = pd.read_parquet(out)
-    assert table["median_error"].is_monotonic_increasing and "whittaker" in set(table["law"])
+    assert table["common_error"].is_monotonic_increasing and "whittaker" in set(table["law"])
 
 
 def test_without_a_study_option_the_command_describes_the_set(capsys):
     assert main(["measurements", "kharaz"]) == 0
     out = capsys.readouterr().out
     assert "split:       3 to fit, 3 to judge" in out and "ranked" not in out
+
+
+def test_rows_judged_on_different_impacts_are_ranked_on_those_all_solved():
+    """A law judged on a subsample (or refused on some impacts) is ranked with the others on
+    the impacts every row solved; its median on all it judged stays beside."""
+    table = pd.DataFrame(
+        {"law": ["a", "b", "c"], "coefficients": "fitted", "median_error": [0.1, 0.2, np.nan]}
+    )
+    judged = pd.DataFrame(
+        {
+            "law": ["a"] * 4 + ["b"] * 2,
+            "coefficients": "fitted",
+            "index": [0, 1, 2, 3, 1, 2],
+            "status": ["ok", "ok", "ok", "failed", "ok", "ok"],
+            "error": [0.1, 0.3, 0.3, np.nan, 0.1, 0.2],
+        }
+    )
+    ranked, common = ranked(table, judged)
+    assert common == 2 and ranked["law"].tolist() == ["b", "a", "c"]
+    assert ranked["common_error"].tolist()[:2] == [pytest.approx(0.15), pytest.approx(0.3)]

@@ -65,6 +65,7 @@ COLUMNS = (
     "law",
     "coefficients",
     "median_error",
+    "common_error",
     "ci_low",
     "ci_high",
     "iqr",
@@ -90,8 +91,11 @@ class MeasuredStudy:
         The measurement set.
     table : DataFrame
         One row per law or baseline and coefficient source (``coefficients``: ``fitted`` or
-        a published source's name), ranked by held-out median error (`COLUMNS`, with one
-        column per fitted field and ``<field>_se`` for its standard error).
+        a published source's name), ranked by held-out median error on the test impacts every
+        row solved (``common_error``; `COLUMNS`, with one column per fitted field and
+        ``<field>_se`` for its standard error).
+    common_count : int
+        The impacts every row with an answer solved, where ``common_error`` is taken.
     predictions : DataFrame
         One row per judged impact and row of ``table``: ``law``, ``coefficients``, ``index``
         (the impact's index in its source), ``status`` (ok, refused, failed), the errors and
@@ -101,6 +105,7 @@ class MeasuredStudy:
     set_name: str
     table: pd.DataFrame
     predictions: pd.DataFrame
+    common_count: int = 0
 
 
 def predict(
@@ -249,9 +254,28 @@ def measured_study(
         predictions.append(judged)
     fields = [f for f in START if any(f in row for row in rows)]
     columns = [*COLUMNS[:2], *fields, *(f"{f}_se" for f in fields), *COLUMNS[2:]]
-    table = pd.DataFrame(rows).reindex(columns=columns)
-    table = table.sort_values("median_error", na_position="last", kind="stable")
-    return MeasuredStudy(chosen.name, table.reset_index(drop=True), pd.concat(predictions))
+    judged = pd.concat(predictions)
+    table, common = ranked(pd.DataFrame(rows).reindex(columns=columns), judged)
+    return MeasuredStudy(chosen.name, table, judged, common)
+
+
+def ranked(table: pd.DataFrame, judged: pd.DataFrame) -> tuple[pd.DataFrame, int]:
+    """The table with ``common_error``, ranked by it, and the number of impacts it is taken on.
+
+    Rows judged on different impacts (a subsample, refusals) are ranked on the impacts that
+    every row with an answer solved: ``common_error`` is the median error there; ties and
+    rows without it follow ``median_error``.
+    """
+    solved = judged[judged["status"] == "ok"] if len(judged) else judged
+    per_row = [set(group) for _, group in solved.groupby(["law", "coefficients"])["index"]]
+    common = set.intersection(*per_row) if per_row else set()
+    medians = (
+        solved[solved["index"].isin(common)].groupby(["law", "coefficients"])["error"].median()
+    )
+    keys = zip(table["law"], table["coefficients"], strict=True)
+    table["common_error"] = [medians.get(key, math.nan) for key in keys]
+    table = table.sort_values(["common_error", "median_error"], na_position="last", kind="stable")
+    return table.reset_index(drop=True), len(common)
 
 
 @dataclass(frozen=True)
@@ -275,6 +299,7 @@ class _Halves:
         """How many impacts of ``half`` a row was fitted or judged on, and why not all."""
         total = self.train_total if half == "train" else self.test_total
         text = f"{half} {used}" if used == total else f"{half} {used} of {total} evenly spaced"
+        text = f"{half} none of {total}" if not used else text
         text = f"quick: {text}" if self.quick else text
         return f"{text}, {refused} refused" if refused else text
 

@@ -34,12 +34,13 @@ COMMAND = (
 )
 # The columns the printed table shows of the study's table, with their headers and widths.
 SHOWN = (
-    ("median_error", "median", 8),
-    ("ci_low", "ci 2.5%", 8),
-    ("ci_high", "97.5%", 8),
-    ("iqr", "iqr", 7),
-    ("normal_error", "normal", 7),
-    ("tangential_error", "tangent", 8),
+    ("common_error", "common", 9),
+    ("median_error", "median", 9),
+    ("ci_low", "ci 2.5%", 9),
+    ("ci_high", "97.5%", 9),
+    ("iqr", "iqr", 9),
+    ("normal_error", "normal", 9),
+    ("tangential_error", "tangent", 9),
     ("cost_s", "cost [s]", 9),
 )
 
@@ -108,7 +109,7 @@ def _study(args: argparse.Namespace) -> None:
             LAWS.get(name)
     out = _output(args.out) if args.out else None
     study = measured_study(measured, laws, quick=args.quick)
-    _print(study.set_name, study.table)
+    _print(study)
     if out is not None:
         _write(study.table, out)
         print(f"table written to {out}")
@@ -140,25 +141,28 @@ def _write(table: object, out: Path) -> None:
         table.to_csv(out, index=False)
 
 
-def _print(set_name: str, table: object) -> None:
+def _print(study: object) -> None:
     """The study's table, best first: the law, its coefficients, its errors and its cost."""
-    fields = [c for c in table.columns if c.endswith("_se")]
-    print(f"{set_name}: laws and baselines ranked by median relative kinetic error on the test")
-    header = f"{'rank':>4}  {'law':<31}{'coefficients':<13}{'fitted (+- std error)':<44}"
-    print(header + "".join(f"{title:>{width}}" for _, title, width in SHOWN) + "  fitted on")
+    table = study.table
+    fields = [c[: -len("_se")] for c in table.columns if c.endswith("_se")]
+    print(
+        f"{study.set_name}: laws and baselines ranked by median relative kinetic error on the "
+        f"{study.common_count} test impacts every row solved (common); median and its 95% "
+        "interval on all the impacts each row judged"
+    )
+    header = f"{'rank':>4}  {'law':<31}{'coefficients':<16}{'fitted (+- std error)':<50}"
+    print(header + "".join(f"{title:>{width}}" for _, title, width in SHOWN) + "  impacts")
     notes = []
     for rank, row in enumerate(table.itertuples(index=False), start=1):
-        values = []
-        for se in fields:
-            name = se[: -len("_se")]
-            value, error = getattr(row, name), getattr(row, se)
-            if isinstance(value, float) and not math.isnan(value):
-                spread = "" if math.isnan(error) else f"+-{error:.2g}"
-                values.append(f"{_short(name)}={value:.3g}{spread}")
+        values = " ".join(
+            _fitted(name, getattr(row, name), getattr(row, f"{name}_se"))
+            for name in fields
+            if not math.isnan(getattr(row, name))
+        )
         cells = "".join(_cell(getattr(row, column), width) for column, _, width in SHOWN)
         print(
-            f"{rank:>4}  {row.law:<31}{row.coefficients:<13}{' '.join(values):<44}{cells}"
-            f"  {row.fitted_on}; judged on {row.judged_on}"
+            f"{rank:>4}  {row.law:<31}{row.coefficients:<16}{values:<50}{cells}"
+            f"  fitted on {row.fitted_on}; judged on {row.judged_on}"
         )
         if row.reason:
             notes.append(
@@ -170,14 +174,16 @@ def _print(set_name: str, table: object) -> None:
         print("\n".join(notes))
 
 
-def _short(name: str) -> str:
-    """A field's name in the printed table (the stiffness ratio's is long)."""
-    return "eta0^2" if name == "tangential_stiffness_ratio" else name
+def _fitted(name: str, value: float, error: float) -> str:
+    """A coefficient with its standard error where it has one (a fitted, not a published one)."""
+    short = "eta0^2" if name == "tangential_stiffness_ratio" else name
+    spread = "" if math.isnan(error) else f"+-{error:.2g}"
+    return f"{short}={value:.3g}{spread}"
 
 
 def _cell(value: float, width: int) -> str:
     """A number in ``width`` characters; an undefined one (NaN) as ``-``."""
-    return f"{'-' if math.isnan(value) else format(value, '.3g'):>{width}}"
+    return " " + f"{'-' if math.isnan(value) else format(value, '.3g'):>{width - 1}}"
 
 
 def _describe(measured: object) -> None:
