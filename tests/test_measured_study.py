@@ -10,7 +10,7 @@ from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS
 from lawbench.core.problem import CONTACT_RANGES
 from lawbench.fitting import heldout
-from lawbench.fitting.measured import COLUMNS, ranked, evenly, measured_study, predict
+from lawbench.fitting.measured import COLUMNS, evenly, measured_study, predict, ranked
 from lawbench.measurements import MEASUREMENTS, MeasurementSet, Processing
 from lawbench.views.cli import main
 
@@ -183,6 +183,6 @@ def test_rows_judged_on_different_impacts_are_ranked_on_those_all_solved():
             "error": [0.1, 0.3, 0.3, np.nan, 0.1, 0.2],
         }
     )
-    ranked, common = ranked(table, judged)
-    assert common == 2 and ranked["law"].tolist() == ["b", "a", "c"]
-    assert ranked["common_error"].tolist()[:2] == [pytest.approx(0.15), pytest.approx(0.3)]
+    ordered, common = ranked(table, judged)
+    assert common == 2 and ordered["law"].tolist() == ["b", "a", "c"]
+    assert ordered["common_error"].tolist()[:2] == [pytest.approx(0.15), pytest.approx(0.3)]
