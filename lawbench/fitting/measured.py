@@ -20,7 +20,8 @@ impact through time (one that reads the contacts' stiffness, ``tags.stiffness``:
 hundreds of milliseconds a solve, against about one for a closed form) is fitted on a fixed,
 evenly spaced subsample of `COSTLY_FIT` training impacts and judged on `COSTLY_JUDGE` test
 impacts; the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK`
-impacts of each half, evenly spaced, for every law.
+impacts of each half, evenly spaced, for every law. Rows judged on different impacts are
+ranked on the impacts every row solved (`ranked`).
 """
 
 from __future__ import annotations
@@ -57,6 +58,7 @@ START = {"e": 0.5, "e_t": 0.0, "mu": 0.2, "tangential_stiffness_ratio": MINDLIN_
 # The impacts a law that integrates in time is fitted and judged on.
 COSTLY_FIT = 16
 COSTLY_JUDGE = 80
+# The impacts of each half the quick mode keeps.
 QUICK = 40
 # The ``coefficients`` of a row whose coefficients were fitted on the training impacts.
 FITTED = "fitted"
