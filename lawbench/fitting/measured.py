@@ -39,7 +39,7 @@ import pandas as pd
 
 from lawbench.core.errors import LawbenchError, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
-from lawbench.core.problem import CONTACT_RANGES, MINDLIN_RATIO
+from lawbench.core.problem import CONTACT_RANGES, MINDLIN_RATIO, Contact
 from lawbench.core.spec import Spec
 from lawbench.fitting import heldout
 from lawbench.fitting.coefficients import Free, start_point
@@ -53,7 +53,8 @@ MAX_SECONDS = 10.0
 # The least squares' tolerances and finite-difference step: above the laws' accuracy at `TOL`.
 FIT_TOL = 1e-6
 DIFF_STEP = 1e-3
-# Where each fitted field starts: inside its range, friction moderate, Mindlin's stiffness ratio.
+# Where each fitted field starts: inside its range, friction moderate, Mindlin's stiffness ratio;
+# another field a law declares starts at the contact's default.
 START = {"e": 0.5, "e_t": 0.0, "mu": 0.2, "tangential_stiffness_ratio": MINDLIN_RATIO}
 # The impacts a law that integrates in time is fitted and judged on.
 COSTLY_FIT = 16
@@ -162,7 +163,8 @@ def free_fields(law: Law) -> list[Free]:
     free = []
     for name in law.fitted:
         low, high, positive = ranges[name]
-        spec = Spec(name, START[name], f"contact field {name}", low=low, high=high)
+        start = START.get(name, getattr(Contact(), name))
+        spec = Spec(name, start, f"contact field {name}", low=low, high=high)
         log = positive and high is None
         free.append(Free(name, spec, None, low, math.inf if high is None else high, log))
     return free
@@ -254,7 +256,7 @@ def measured_study(
         row, judged = _study_baseline(name, basis, halves)
         rows.append(row)
         predictions.append(judged)
-    fields = [f for f in START if any(f in row for row in rows)]
+    fields = list(dict.fromkeys(name for law in law_objects for name in law.fitted))
     columns = [*COLUMNS[:2], *fields, *(f"{f}_se" for f in fields), *COLUMNS[2:]]
     judged = pd.concat(predictions)
     table, common = ranked(pd.DataFrame(rows).reindex(columns=columns), judged)
@@ -336,7 +338,7 @@ def _study_law(
     """The rows of one law: fitted, then at each published source that gives all its fields."""
     started = time.perf_counter()
     free = free_fields(law)
-    start = {f.name: START[f.name] for f in free}
+    start = {f.name: f.spec.default for f in free}
     train, refused_train = _screen(law, halves.train, start)
     test, refused_test = _screen(law, halves.test, start)
     fitted = None
