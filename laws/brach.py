@@ -79,6 +79,7 @@ class Brach(Law):
     summary = "Brach's bilinear law (e, e_t, mu) at one contact, with effective masses"
     source = "Brach 1989, 1991; Brogliato 2010, eq. (11)"
     tags = Tags(friction=True, several_contacts=False, spatial=True)
+    fitted = ("e", "e_t", "mu")
     separating_rule = "a separating contact takes no impulse"
 
     findings = (

@@ -177,6 +177,7 @@ class Moreau(Law):
         "2011; Anitescu 2006"
     )
     tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="tol")
+    fitted = ("e", "mu")
     takes_sparse = True
     # Its frictionless impulses solve the LCP that clarabel and Siconos' Lemke are timed on.
     bench_roles = ("lcp",)

@@ -395,6 +395,7 @@ class Whittaker(Law):
         "Kane and Levinson 1985"
     )
     tags = Tags(friction=True, several_contacts=True, spatial=True)
+    fitted = ("e", "mu")
     separating_rule = (
         "a separating contact is held at un+ >= 0 without restitution, as in Moreau's "
         "unilateral law"

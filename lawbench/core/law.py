@@ -237,6 +237,9 @@ class Law(ABC):
     # `resolve` then solves a problem of extreme scale in units near it (`ImpactProblem.units`)
     # and scales the answer back; a law that reads a damping solves in the problem's own units.
     scale_free: ClassVar[bool] = True
+    # The contact fields (`lawbench.core.problem.Contact`) the law reads and a fit to measured
+    # impacts may free, each within its `CONTACT_RANGES`; the others keep their values.
+    fitted: ClassVar[tuple[str, ...]] = ("e",)
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         """Give every law the wall-clock budget ``max_seconds`` (`lawbench.core.law`)."""

@@ -99,6 +99,7 @@ class Compliant(Law):
     tags = Tags(
         friction=True, several_contacts=True, spatial=True, stiffness=True, accuracy_knob="tol"
     )
+    fitted = ("e", "mu", "tangential_stiffness_ratio")
     separating_rule = (
         "a separating contact carries a force only while its spring is compressed, if the "
         "motion closes it again"

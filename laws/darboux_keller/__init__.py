@@ -92,6 +92,7 @@ class DarbouxKeller(Law):
     )
     source = "Darboux 1880, Keller 1986, Stronge 1990; Brogliato 2010, eqs. (2)-(4), (12)-(15)"
     tags = Tags(friction=True, several_contacts=False, spatial=True, accuracy_knob="tol")
+    fitted = ("e", "mu")
     separating_rule = "a separating contact takes no impulse"
     guarantees = (
         keeps_energy(

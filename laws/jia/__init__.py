@@ -103,6 +103,7 @@ class Jia(Law):
         stiffness=True,
         accuracy_knob="tol",
     )
+    fitted = ("e", "mu", "tangential_stiffness_ratio")
     separating_rule = (
         "a separating contact is inactive until its gap rate turns negative, then it is "
         "compressed like any other"

@@ -138,6 +138,7 @@ class LiuZhaoBrogliato(Law):
     )
     source = "Brogliato 2010, eqs. (32)-(48); Liu, Zhao, Brogliato 2008, 2009; Zhang et al. 2013"
     tags = Tags(friction=True, several_contacts=True, stiffness=True, accuracy_knob="tol")
+    fitted = ("e", "mu")
     separating_rule = (
         "a separating contact receives no impulse unless the others make it approach, "
         "then it is compressed like any other"
