@@ -380,6 +380,11 @@ class Law(ABC):
         """Resolve a problem whose contacts are all closed."""
 
     @property
+    def vectorizes_batches(self) -> bool:
+        """Whether the law solves a `ProblemBatch` in a few numpy calls (`_resolve_batch`)."""
+        return type(self)._resolve_batch is not Law._resolve_batch
+
+    @property
     def solves_contact_problems(self) -> bool:
         """Whether the law solves a `ContactProblem` (it implements `_solve_contact`)."""
         return type(self)._solve_contact is not Law._solve_contact

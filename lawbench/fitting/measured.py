@@ -9,8 +9,9 @@ The fitted law then predicts the test half, and so does the law at each publishe
 coefficients the set's facts give (for a law all of whose fitted fields they give), and the two
 baselines fitted on the same training impacts.
 
-Every solve goes through `predict`, one small function, so that a vectorized path can replace
-it. Each law solves with its accuracy knob ``tol`` at `TOL` (far below the measurements'
+Every solve goes through `predict`: a law with a vectorized path (`Law.vectorizes_batches`)
+solves the impacts of each shape as one `ProblemBatch` (its closed forms, exact), the others one
+by one. Each law solves with its accuracy knob ``tol`` at `TOL` (far below the measurements'
 noise) and a per-solve budget of `MAX_SECONDS`. A law that fits no friction coefficient is
 refused on impacts measured with friction (a tangential row), and a law's own `NotApplicable`
 refuses an impact; a `SolverFailure` is counted, its impact left out of the errors.
@@ -37,6 +38,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from lawbench.core.batch import COEFFICIENTS as BATCH_COEFFICIENTS
+from lawbench.core.batch import ProblemBatch
 from lawbench.core.errors import LawbenchError, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import CONTACT_RANGES, MINDLIN_RATIO, Contact
@@ -141,8 +144,11 @@ def predict(
     n = impacts[0].problem.n if impacts else 0
     velocities = np.full((len(impacts), n), np.nan)
     failures: dict[int, LawbenchError] = {}
-    for k, impact in enumerate(impacts):
-        problem = impact.problem
+    alone = list(range(len(impacts)))
+    if law.vectorizes_batches and set(coefficients) <= set(BATCH_COEFFICIENTS):
+        alone = _predict_batches(law, impacts, coefficients, options, velocities)
+    for k in alone:
+        problem = impacts[k].problem
         contacts = tuple(dataclasses.replace(c, **coefficients) for c in problem.contacts)
         try:
             outcome = law.resolve(dataclasses.replace(problem, contacts=contacts), **options)
@@ -151,6 +157,37 @@ def predict(
             continue
         velocities[k] = outcome.v_plus
     return velocities, failures
+
+
+def _predict_batches(
+    law: Law,
+    impacts: Sequence[MeasuredImpact],
+    coefficients: Mapping[str, float],
+    options: Mapping[str, Any],
+    velocities: np.ndarray,
+) -> list[int]:
+    """Solve the impacts of each shape as one `ProblemBatch`; return the positions left.
+
+    A batch that raises (a problem the vectorized path leaves to the one-by-one solve, which
+    refuses or fails it) is left whole to `predict`'s loop, which records each impact's error.
+    """
+    shapes: dict[tuple[int, int, int], list[int]] = {}
+    for k, impact in enumerate(impacts):
+        problem = impact.problem
+        shapes.setdefault((problem.n, problem.m, problem.d), []).append(k)
+    alone: list[int] = []
+    for positions in shapes.values():
+        stacked = ProblemBatch.from_problems([impacts[k].problem for k in positions])
+        given = {
+            name: np.full((len(positions), stacked.m), value)
+            for name, value in coefficients.items()
+        }
+        try:
+            batch = dataclasses.replace(stacked, coefficients={**stacked.coefficients, **given})
+            velocities[positions] = law.resolve_batch(batch, **options).v_plus
+        except LawbenchError:
+            alone += positions
+    return sorted(alone)
 
 
 def free_fields(law: Law) -> list[Free]:
@@ -324,7 +361,7 @@ def _screen(
             reason = "fits no friction coefficient, and the impacts were measured with friction"
         else:
             contacts = tuple(dataclasses.replace(c, **coefficients) for c in problem.contacts)
-            reason = law.tags.refusal(dataclasses.replace(problem, contacts=contacts))
+            reason = law.refusal(dataclasses.replace(problem, contacts=contacts))
         if reason:
             refused[f"{law.name}: {reason}"] += 1
         else:

@@ -13,7 +13,7 @@ import math
 from pathlib import Path
 
 from lawbench.core.errors import InvalidProblem
-from lawbench.views.cli.common import _path
+from lawbench.views.cli.main import _path
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = (
