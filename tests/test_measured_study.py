@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lawbench.core.errors import NotApplicable
+from lawbench.core.errors import InvalidProblem, NotApplicable
 from lawbench.core.law import LAWS
 from lawbench.core.problem import CONTACT_RANGES
 from lawbench.fitting import heldout
@@ -186,3 +186,19 @@ def test_rows_judged_on_different_impacts_are_ranked_on_those_all_solved():
     ordered, common = ranked(table, judged)
     assert common == 2 and ordered["law"].tolist() == ["b", "a", "c"]
     assert ordered["common_error"].tolist()[:2] == [pytest.approx(0.15), pytest.approx(0.3)]
+
+
+@pytest.mark.slow
+def test_laws_studied_side_by_side_give_the_same_table():
+    """Two worker processes give the table one process gives, timings aside (Kharaz's set)."""
+    laws = ["whittaker", "brach"]
+    one = measured_study("kharaz", laws, quick=True, workers=1).table
+    two = measured_study("kharaz", laws, quick=True, workers=2).table
+    timings = ["cost_s", "wall_s"]
+    pd.testing.assert_frame_equal(one.drop(columns=timings), two.drop(columns=timings))
+
+
+def test_a_study_needs_a_worker():
+    """Fewer than one worker is refused by name."""
+    with pytest.raises(InvalidProblem, match="workers = 0"):
+        measured_study("kharaz", ["whittaker"], workers=0)

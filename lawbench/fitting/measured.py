@@ -21,17 +21,20 @@ impact through time (one that reads the contacts' stiffness, ``tags.stiffness``:
 hundreds of milliseconds a solve, against about one for a closed form) is fitted on a fixed,
 evenly spaced subsample of `COSTLY_FIT` training impacts and judged on `COSTLY_JUDGE` test
 impacts; the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK`
-impacts of each half, evenly spaced, for every law. Rows judged on different impacts are
-ranked on the impacts every row solved (`ranked`).
+impacts of each half, evenly spaced, and `QUICK_COSTLY_FIT` and `QUICK_COSTLY_JUDGE` of them for
+a law that integrates in time. Rows judged on different impacts are ranked on the impacts every
+row solved (`ranked`). ``workers`` processes study the laws side by side.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import multiprocessing
 import time
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -40,7 +43,7 @@ import pandas as pd
 
 from lawbench.core.batch import COEFFICIENTS as BATCH_COEFFICIENTS
 from lawbench.core.batch import ProblemBatch
-from lawbench.core.errors import LawbenchError, NotApplicable, SolverFailure
+from lawbench.core.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import CONTACT_RANGES, MINDLIN_RATIO, Contact
 from lawbench.core.spec import Spec
@@ -60,8 +63,11 @@ DIFF_STEP = 1e-3
 # another field a law declares starts at the contact's default.
 START = {"e": 0.5, "e_t": 0.0, "mu": 0.2, "tangential_stiffness_ratio": MINDLIN_RATIO}
 # The impacts a law that integrates in time is fitted and judged on.
-COSTLY_FIT = 16
-COSTLY_JUDGE = 80
+COSTLY_FIT = 8
+COSTLY_JUDGE = 40
+# The same in the quick mode.
+QUICK_COSTLY_FIT = 4
+QUICK_COSTLY_JUDGE = 10
 # The impacts of each half the quick mode keeps.
 QUICK = 40
 # The ``coefficients`` of a row whose coefficients were fitted on the training impacts.
@@ -257,6 +263,7 @@ def measured_study(
     measured: str | MeasurementSet,
     laws: Sequence[str | Law] | None = None,
     quick: bool = False,
+    workers: int = 1,
 ) -> MeasuredStudy:
     """Fit every law on a set's training impacts and judge it, with the baselines, on its test.
 
@@ -267,7 +274,11 @@ def measured_study(
     laws : sequence of str or Law, optional
         The laws (default: every registered law).
     quick : bool
-        Keep `QUICK` impacts of each half, evenly spaced.
+        Keep `QUICK` impacts of each half, evenly spaced (`QUICK_COSTLY_FIT` and
+        `QUICK_COSTLY_JUDGE` for a law that integrates in time).
+    workers : int
+        Processes that study the laws side by side (1: in this process); the table is the
+        same for any number.
 
     Returns
     -------
@@ -277,16 +288,25 @@ def measured_study(
     Raises
     ------
     InvalidProblem
-        An unknown set or law name.
+        An unknown set or law name, or fewer than one worker.
     """
     chosen = MEASUREMENTS.get(measured)
     law_objects = [LAWS.get(law) for law in (LAWS.names() if laws is None else laws)]
+    if workers < 1:
+        raise InvalidProblem(f"workers = {workers}: must be at least 1")
     halves = _Halves.of(chosen, quick)
     sources = heldout.published(chosen.facts)
+    if workers == 1 or len(law_objects) < 2 or chosen.name not in MEASUREMENTS.names():
+        studied = [_study_law(law, halves, sources) for law in law_objects]
+    else:
+        jobs = [(law.name, chosen.name, quick) for law in law_objects]
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=context) as pool:
+            studied = list(pool.map(_study_law_by_name, jobs))
     rows: list[dict[str, Any]] = []
     predictions: list[pd.DataFrame] = []
-    for law in law_objects:
-        for row, judged in _study_law(law, halves, sources):
+    for results in studied:
+        for row, judged in results:
             rows.append(row)
             predictions.append(judged)
     for name, basis in heldout.BASELINES.items():
@@ -298,6 +318,13 @@ def measured_study(
     judged = pd.concat(predictions)
     table, common = ranked(pd.DataFrame(rows).reindex(columns=columns), judged)
     return MeasuredStudy(chosen.name, table, judged, common)
+
+
+def _study_law_by_name(job: tuple[str, str, bool]) -> list[tuple[dict[str, Any], pd.DataFrame]]:
+    """`_study_law` in a worker process, from the names of the law and the registered set."""
+    law, measured, quick = job
+    chosen = MEASUREMENTS.get(measured)
+    return _study_law(LAWS.get(law), _Halves.of(chosen, quick), heldout.published(chosen.facts))
 
 
 def ranked(table: pd.DataFrame, judged: pd.DataFrame) -> tuple[pd.DataFrame, int]:
@@ -335,6 +362,11 @@ class _Halves:
         if quick:
             return cls(evenly(train, QUICK), evenly(test, QUICK), len(train), len(test), True)
         return cls(train, test, len(train), len(test), False)
+
+    @property
+    def costly(self) -> tuple[int, int]:
+        """How many impacts a law that integrates in time is fitted and judged on."""
+        return (QUICK_COSTLY_FIT, QUICK_COSTLY_JUDGE) if self.quick else (COSTLY_FIT, COSTLY_JUDGE)
 
     def label(self, half: str, used: int, refused: int = 0) -> str:
         """How many impacts of ``half`` a row was fitted or judged on, and why not all."""
@@ -379,7 +411,7 @@ def _study_law(
     train, refused_train = _screen(law, halves.train, start)
     test, refused_test = _screen(law, halves.test, start)
     fitted = None
-    fit_count, judge_count = (COSTLY_FIT, COSTLY_JUDGE) if law.tags.stiffness else (None, None)
+    fit_count, judge_count = halves.costly if law.tags.stiffness else (None, None)
     if train and test:
         fitted, fitted_on, refused_fit = _fit(law, free, start, evenly(train, fit_count))
         refused_train += refused_fit

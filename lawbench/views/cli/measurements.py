@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 from lawbench.core.errors import InvalidProblem
-from lawbench.views.cli.main import _path
+from lawbench.views.cli.main import MAX_WORKERS, _count, _path
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = (
@@ -60,7 +61,14 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--quick",
         action="store_true",
-        help="the study on 40 evenly spaced impacts of each half",
+        help="the study on 40 evenly spaced impacts of each half (fewer for the laws that "
+        "integrate in time)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=_count(1, MAX_WORKERS),
+        help=f"processes that study the laws side by side, at most {MAX_WORKERS} (default: one "
+        "per core)",
     )
     parser.add_argument(
         "--out",
@@ -75,7 +83,7 @@ def run(args: argparse.Namespace) -> None:
     """List the sets, print one set's record, or run and print the study on one set."""
     from lawbench.measurements import MEASUREMENTS
 
-    if args.study or args.laws or args.quick or args.out:
+    if args.study or args.laws or args.quick or args.out or args.workers:
         _study(args)
         return
     if args.set is None:
@@ -108,7 +116,8 @@ def _study(args: argparse.Namespace) -> None:
         for name in laws:
             LAWS.get(name)
     out = _output(args.out) if args.out else None
-    study = measured_study(measured, laws, quick=args.quick)
+    workers = args.workers or os.cpu_count() or 1
+    study = measured_study(measured, laws, quick=args.quick, workers=workers)
     _print(study)
     if out is not None:
         _write(study.table, out)
