@@ -177,14 +177,14 @@ def from_user(before: int) -> bool:
     """Whether a `KeyboardInterrupt` caught now is the user's Ctrl-C.
 
     ``before`` is `user_interrupts` when the code that raised it began. The rule: outside the
-    main thread no signal raises, so the code raised it itself; in the main thread it is the
-    user's when a SIGINT arrived meanwhile, or when SIGINTs are not watched (then lawbench
-    cannot tell, and lets it end the command).
+    main thread, or where SIGINT is ignored (a guarded worker), no signal raises it, so the code
+    raised it itself; otherwise it is the user's when a SIGINT arrived meanwhile, or when
+    SIGINTs are not watched (then lawbench cannot tell, and lets it end the command).
     """
-    if not in_main_thread():
+    handler = signal.getsignal(signal.SIGINT)
+    if not in_main_thread() or handler == signal.SIG_IGN:
         return False
-    watched = signal.getsignal(signal.SIGINT) is _Interrupts.handler
-    return not watched or _Interrupts.count != before
+    return handler is not _Interrupts.handler or _Interrupts.count != before
 
 
 # Relative disagreement, beyond rounding, between the numbers a law reports and its velocities:
