@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 import pytest
+from test_plugins import distribution
 
 import lawbench
 from lawbench.checks import run_checks
@@ -229,11 +230,8 @@ SHORT = lawbench.Spec("max_seconds", 0.3, "wall-clock budget of one solve", unit
 
 
 class Sleeper(lawbench.Law):
-    name = "sleeper"
-    summary = "sleeps instead of solving"
-    source = "none"
-    tags = lawbench.Tags()
-    options = (SHORT,)
+    name, summary, source = "sleeper", "sleeps instead of solving", "none"
+    tags, options = lawbench.Tags(), (SHORT,)
 
     def _resolve(self, problem, options):
         time.sleep(1000)
@@ -278,17 +276,12 @@ lone_ball = hostile_plugin:BallOnWall
 
 @pytest.fixture(scope="module")
 def hostile_env(tmp_path_factory):
-    root = tmp_path_factory.mktemp("hostile")
-    (root / "hostile_plugin.py").write_text(textwrap.dedent(HOSTILE))
-    (root / "exits_at_import.py").write_text(EXITS)
-    (root / "interrupts_at_import.py").write_text(INTERRUPTS)
-    info = root / "hostile_plugin-0.1.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: hostile-plugin\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text(ENTRY_POINTS)
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(root), env.get("PYTHONPATH", "")])
-    return env
+    modules = {
+        "hostile_plugin": textwrap.dedent(HOSTILE),
+        "exits_at_import": EXITS,
+        "interrupts_at_import": INTERRUPTS,
+    }
+    return distribution(tmp_path_factory.mktemp("hostile"), "hostile-plugin", modules, ENTRY_POINTS)
 
 
 def cli(env, *argv, cwd=None):
