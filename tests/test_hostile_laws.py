@@ -325,3 +325,15 @@ def test_check_and_run_stop_a_law_that_sleeps(hostile_env, tmp_path):
     )
     assert ran.returncode == 0, ran.stderr
     assert WALL_CLOCK in (tmp_path / "run.csv").read_text()
+
+
+def test_an_answer_that_breaks_a_promise_is_a_solver_failure_never_ok():
+    """A contact left approaching (a promise of every law) ends ``lawbench solve``, exit 4."""
+    from lawbench.views.cli.solve import _refuse_broken_promises
+
+    def pulls(self, problem, options):
+        return lawbench.Outcome.from_impulses(problem, np.array([-1.0]))
+
+    trial = lawbench.evaluate(broken(pulls), ball())
+    with pytest.raises(SolverFailure, match="admissible fails where it must hold"):
+        _refuse_broken_promises(trial, run_checks(trial))
