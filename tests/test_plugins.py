@@ -72,17 +72,27 @@ ball_on_wall = toy_plugin:BallOnWall
 """
 
 
+def distribution(root, name, modules, entry_points):
+    """Write a distribution of ``modules`` (name -> source) with ``entry_points`` into ``root``.
+
+    Returns the environment that puts it on ``PYTHONPATH``.
+    """
+    for module, source in modules.items():
+        (root / f"{module}.py").write_text(source)
+    info = root / f"{name.replace('-', '_')}-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(entry_points)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(root), env.get("PYTHONPATH", "")])
+    return env
+
+
 @pytest.fixture(scope="module")
 def plugin_env(tmp_path_factory):
     root = tmp_path_factory.mktemp("plugin")
-    (root / "toy_plugin.py").write_text(textwrap.dedent(TOY))
-    info = root / "toy_plugin-0.1.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: toy-plugin\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text(ENTRY_POINTS)
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(root), env.get("PYTHONPATH", "")])
-    return root, env
+    modules = {"toy_plugin": textwrap.dedent(TOY)}
+    return root, distribution(root, "toy-plugin", modules, ENTRY_POINTS)
 
 
 def lawbench_cli(env, *argv, cwd=None):

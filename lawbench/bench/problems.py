@@ -22,7 +22,8 @@ import pandas as pd
 from lawbench.bench.peer import siconos_available, siconos_nsgs, siconos_reads_fclib
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
-from lawbench.core.law import LAWS, WALL_CLOCK, alarm
+from lawbench.core.guards import WALL_CLOCK, alarm
+from lawbench.core.law import LAWS
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import make_trial

@@ -6,7 +6,11 @@ verdict of the taxonomy (`lawbench.core.verdicts`) from the law's findings and g
 
 The single-solve checks here: energy, admissibility, impulses, friction, momentum and
 references; the checks that solve again register themselves through `check` from their own
-modules.
+modules. They read the answer's velocities, never what a law says about itself: the energies
+are ``v @ M @ v / 2`` of the problem's ``v`` and the answer's ``v_plus``, and the impulses are
+judged only as a decomposition of the velocity change, ``Wn Pn + Wt Pt = M (v+ - v-)``
+(`Law.resolve` refuses an answer whose impulses are not one; a trial made otherwise fails the
+impulse checks).
 """
 
 from __future__ import annotations
@@ -19,9 +23,10 @@ import numpy as np
 
 from lawbench.core.case import Case
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.guards import CONSISTENCY
 from lawbench.core.law import Law
 from lawbench.core.metric import is_sparse
-from lawbench.core.outcome import gap_rates
+from lawbench.core.outcome import gap_rates, generalized_impulse
 from lawbench.core.problem import RESTITUTION_FIELDS, ImpactProblem
 from lawbench.core.trial import Trial, evaluate
 from lawbench.core.verdicts import Claim, Verdict
@@ -238,14 +243,21 @@ def _scale(values: np.ndarray) -> float:
     return float(np.abs(values).max()) if values.size and np.abs(values).max() > 0 else 1.0
 
 
+def _energies(trial: Trial) -> tuple[float, float, float]:
+    """``dT``, ``T-`` and ``dT / T-`` (``dT`` when T- = 0) from the velocities before and after."""
+    problem = trial.problem
+    T_minus = problem.T_minus
+    dT = problem.kinetic_energy(trial.outcome.v_plus) - T_minus
+    return dT, T_minus, dT / T_minus if T_minus > 0 else dT
+
+
 @check("energy_gain")
 def energy_gain(trial: Trial) -> tuple:
     """Relative kinetic energy change ``dT / T-``; passes unless energy is created."""
-    outcome = trial.outcome
-    relative = outcome.dT / outcome.T_minus if outcome.T_minus > 0 else outcome.dT
+    dT, T_minus, relative = _energies(trial)
     passed = relative <= TOLERANCE
     verb = "creates" if not passed else "keeps or dissipates"
-    return relative, passed, f"{verb} energy: dT = {outcome.dT:.6g} J, T- = {outcome.T_minus:.6g} J"
+    return relative, passed, f"{verb} energy: dT = {dT:.6g} J, T- = {T_minus:.6g} J"
 
 
 @check("energy_kept")
@@ -256,16 +268,16 @@ def energy_kept(trial: Trial) -> tuple:
     Newton's, Poisson's and the energetic sense alike), where a law that keeps energy must
     keep it to rounding.
     """
-    problem, outcome = trial.problem, trial.outcome
+    problem = trial.problem
     if problem.frictional:
         return None, None, "some contact has friction"
     closed = problem.closed
     if not all((problem.restitution(kind)[closed] == 1.0).all() for kind in RESTITUTION_FIELDS):
         return None, None, "some closed contact is not elastic (e < 1)"
-    relative = outcome.dT / outcome.T_minus if outcome.T_minus > 0 else outcome.dT
+    dT, T_minus, relative = _energies(trial)
     passed = abs(relative) <= TOLERANCE
     verb = "keeps" if passed else ("loses" if relative < 0 else "creates")
-    return relative, passed, f"{verb} energy: dT = {outcome.dT:.6g} J, T- = {outcome.T_minus:.6g} J"
+    return relative, passed, f"{verb} energy: dT = {dT:.6g} J, T- = {T_minus:.6g} J"
 
 
 @check("admissible", promised=True)
@@ -292,9 +304,35 @@ def admissible(trial: Trial) -> tuple:
     return value, False, f"contact {worst} approaches after the impact (un+ = {after.min():.6g})"
 
 
+# Relative mismatch between ``Wn Pn + Wt Pt`` and ``M (v+ - v-)`` beyond which the impulses are
+# not those of the velocity change (`lawbench.core.law.CONSISTENCY`, which `Law.resolve` holds).
+IMPULSE_MISMATCH = CONSISTENCY
+
+
+def _unexplained_impulses(trial: Trial) -> str:
+    """Why the answer's impulses are not a decomposition of its velocity change, or ''."""
+    problem, outcome = trial.problem, trial.outcome
+    change = problem.M @ (outcome.v_plus - problem.v)
+    impulse = generalized_impulse(problem, outcome.Pn, outcome.Pt)
+    scale = max(_scale(problem.M @ problem.v), _scale(change), _scale(impulse))
+    mismatch = float(np.abs(impulse - change).max()) / scale
+    if mismatch <= IMPULSE_MISMATCH:
+        return ""
+    return (
+        f"the impulses are not those of the velocity change: |Wn Pn + Wt Pt - M (v+ - v-)| is "
+        f"{mismatch:.3g} of the momenta"
+    )
+
+
 @check("impulse_sign", promised=True)
 def impulse_sign(trial: Trial) -> tuple:
-    """Smallest normal impulse over the largest one; a negative impulse is tensile."""
+    """Smallest normal impulse over the largest one; a negative impulse is tensile.
+
+    The impulses judged are the answer's, once they are shown to produce its velocity change.
+    """
+    unexplained = _unexplained_impulses(trial)
+    if unexplained:
+        return None, False, unexplained
     Pn = trial.outcome.Pn
     value = float(Pn.min()) / _scale(Pn)
     if value >= -TOLERANCE:
@@ -308,6 +346,9 @@ def friction_cone(trial: Trial) -> tuple:
     problem, outcome = trial.problem, trial.outcome
     if problem.Wt is None:
         return None, None, "the scene has no tangential direction (frictionless)"
+    unexplained = _unexplained_impulses(trial)
+    if unexplained:
+        return None, False, unexplained
     # In units of the largest impulse, where the norms of impulses near 1e308 do not overflow;
     # a contact deep inside a wide cone (mu = 1e300) counts as an excess of -1 at most.
     scale = _scale(np.concatenate([outcome.Pn, outcome.Pt]))

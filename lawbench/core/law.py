@@ -15,7 +15,17 @@ restarts at events), each when the law declares it. The law's loops spend from
 `current_budget()` (the event integrator of `lawbench.numerics.integrator` does it for the
 integrating laws; an iterative solver calls `Budget.step` once per iteration), and a budget that
 runs out raises `BudgetExceeded` naming the option, its amount and the seconds spent, which is
-what a budget cell of a table shows. `alarm` stops from outside a solve that ignores its own.
+what a budget cell of a table shows. `lawbench.core.guards.alarm` stops from outside a solve
+that ignores its own (`lawbench.core.trial.make_trial` sets it).
+
+A law is code from anywhere, so `Law.resolve` holds every answer of `Law._resolve` to what the
+checks read: a `SystemExit` or `KeyboardInterrupt` raised by the law (not by the user's Ctrl-C)
+and a `MemoryError` are a `SolverFailure` of that law; so are an answer that is no `Outcome`, or
+whose ``v_plus``, ``Pn`` or ``Pt`` has the wrong length, a problem or options the law wrote into
+(a digest taken before and after), and reported numbers that disagree with the answer's own
+velocities: ``T_minus`` and ``T_plus`` against ``v @ M @ v / 2``, and the impulses against the
+velocity change, ``Wn Pn + Wt Pt = M (v+ - v-)``, each beyond its rounding
+(`lawbench.core.guards`).
 
 A law that also solves Coulomb's frictional contact problem in contact space (FCLIB's local
 form, `lawbench.core.contact.ContactProblem`: no generalized coordinates, only ``W``, ``q`` and
@@ -30,20 +40,23 @@ import contextvars
 import dataclasses
 import functools
 import math
-import signal
-import threading
 import time
 import warnings
 from abc import ABC, abstractmethod
-from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
-from lawbench.core.metric import all_finite
+from lawbench.core.guards import (
+    from_user,
+    inputs,
+    refuse_non_finite,
+    user_interrupts,
+    verify_answer,
+)
 from lawbench.core.outcome import Outcome, embedded, scaled_back
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.registry import Registry
@@ -166,39 +179,6 @@ _OPEN: contextvars.ContextVar[Budget | None] = contextvars.ContextVar("budget", 
 def current_budget() -> Budget:
     """The budget of the solve under way; an unbounded one outside any solve."""
     return _OPEN.get() or Budget("lawbench")
-
-
-# The budget that a stop from outside the solve names.
-WALL_CLOCK = "wall-clock guard"
-
-
-def stopped(seconds: float) -> BudgetExceeded:
-    """The error of a job stopped by the guard after ``seconds``."""
-    return BudgetExceeded(
-        f"no answer within {seconds:g} s: stopped by the {WALL_CLOCK}", WALL_CLOCK, seconds, seconds
-    )
-
-
-@contextmanager
-def alarm(seconds: float | None) -> Iterator[None]:
-    """Raise `stopped` inside the enclosed code once ``seconds`` have passed.
-
-    No guard when ``seconds`` is None or outside the main thread (signals reach only it).
-    """
-    if not seconds or threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def ring(signum: int, frame: Any) -> None:
-        raise stopped(seconds)
-
-    previous = signal.signal(signal.SIGALRM, ring)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 class Law(ABC):
@@ -346,11 +326,15 @@ class Law(ABC):
             outcome = self._resolve_closed(solved, values)
         if solved is not problem:
             outcome = scaled_back(outcome, problem, units)
+            refuse_non_finite(  # scaled back, a number may overflow
+                self.name,
+                v_plus=outcome.v_plus,
+                Pn=outcome.Pn,
+                Pt=outcome.Pt,
+                T_plus=outcome.T_plus,
+            )
         if problem.Wt is not None and outcome.Pt.size == 0:
             outcome = dataclasses.replace(outcome, Pt=np.zeros(problem.m * problem.d))
-        _refuse_non_finite(
-            self.name, v_plus=outcome.v_plus, Pn=outcome.Pn, Pt=outcome.Pt, T_plus=outcome.T_plus
-        )
         outcome.diagnostics["options"] = values
         if negligible:
             outcome.diagnostics["negligible_friction"] = (
@@ -365,14 +349,34 @@ class Law(ABC):
     def _resolve_closed(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         """`_resolve` on the closed contacts only (all of them for a law that follows gaps)."""
         if problem.closed_count == problem.m or self.follows_gaps:
-            return self._resolve(problem, options)
+            return self._answer(problem, options)
         if problem.closed_count:
             closed = problem.closed
-            return embedded(
-                self._resolve(problem.select_contacts(closed), options), closed, problem
-            )
+            return embedded(self._answer(problem.select_contacts(closed), options), closed, problem)
         outcome = Outcome.from_impulses(problem, np.zeros(problem.m))
         outcome.diagnostics["formulation"] = "no closed contact"
+        return outcome
+
+    def _answer(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
+        """`_resolve`, its answer held to what the checks read (see the module docstring)."""
+        given = inputs(problem, options)
+        before = user_interrupts()
+        try:
+            outcome = self._resolve(problem, options)
+        except KeyboardInterrupt:
+            if from_user(before):
+                raise
+            raise SolverFailure(f"{self.name}: the law raised KeyboardInterrupt") from None
+        except SystemExit as exc:
+            raise SolverFailure(f"{self.name}: the law called sys.exit({exc.code!r})") from None
+        except MemoryError:
+            raise SolverFailure(f"{self.name}: out of memory (MemoryError)") from None
+        for what, now, then in zip(
+            ("problem", "options"), inputs(problem, options), given, strict=True
+        ):
+            if now != then:
+                raise SolverFailure(f"{self.name}: the law wrote into the {what} it was given")
+        verify_answer(self.name, problem, outcome)
         return outcome
 
     @abstractmethod
@@ -426,7 +430,7 @@ class Law(ABC):
             )
         with _Watch(self.name, values) as watch:
             r, diagnostics = self._solve_contact(problem, values)
-        _refuse_non_finite(self.name, r=r)
+        refuse_non_finite(self.name, r=r)
         diagnostics.update(watch.record, W_asymmetry=problem.asymmetry)
         return ContactSolution(r, problem.velocity(r), problem.error(r), diagnostics)
 
@@ -469,7 +473,7 @@ class Law(ABC):
         with _Watch(self.name, values) as watch:
             answer = None if scaled else self._resolve_batch(batch, values)
             result = self._completed(batch, answer, values)
-        _refuse_non_finite(self.name, v_plus=result.v_plus)
+        refuse_non_finite(self.name, v_plus=result.v_plus)
         result.diagnostics.update(watch.record)
         return result
 
@@ -564,17 +568,6 @@ class _Watch:
         heard = sorted({f"{w.category.__name__}: {w.message}" for w in self.caught})
         if heard:
             self.record["warnings"] = heard
-
-
-def _refuse_non_finite(name: str, **fields: Any) -> None:
-    """Raise `SolverFailure` naming the first of ``fields`` that holds a non-finite number."""
-    for field, value in fields.items():
-        if isinstance(value, float):
-            finite = math.isfinite(value)
-        else:
-            finite = not value.size or all_finite(value)
-        if not finite:
-            raise SolverFailure(f"{name}: non-finite {field} {value}")
 
 
 LAWS: Registry[Law] = Registry("law", "lawbench.laws", Law)

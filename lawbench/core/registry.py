@@ -9,7 +9,10 @@ built-in module or a plugin's entry point) and only that, when it registers the 
 for every name, it imports everything. So importing lawbench, and solving with one law on one
 scene, stay cheap. A module or plugin that fails to import, raises, or
 registers a name twice is skipped and its reason kept in `Registry.unavailable` instead of
-breaking the others.
+breaking the others. So is a plugin whose import calls `sys.exit`, raises `KeyboardInterrupt`
+itself (a Ctrl-C from the user still ends the command: `lawbench.core.guards.user_interrupts`),
+or runs longer than `PLUGIN_IMPORT_S` seconds (`lawbench.core.guards.alarm`, which stops Python
+code; an import stuck inside compiled code is beyond an in-process bound).
 
 A registry is a read-only mapping of names to entries: ``LAWS["newton"]``, ``"newton" in
 LAWS``, iteration over the names, ``keys()``, ``values()``, ``items()``, ``len()``. An unknown
@@ -24,9 +27,14 @@ import importlib.util
 import inspect
 import pkgutil
 from collections.abc import Iterator, Mapping
-from typing import Protocol, TypeVar
+from typing import Any, Protocol, TypeVar
 
-from lawbench.core.errors import UnknownName
+from lawbench.core.errors import BudgetExceeded, UnknownName
+from lawbench.core.guards import alarm, from_user, user_interrupts
+
+# Seconds a plugin's import may take before it is listed as unavailable: an import reads
+# modules and perhaps data, and lawbench's own slowest optional engine imports in about two.
+PLUGIN_IMPORT_S = 10.0
 
 
 def _entry_points(**selection: str) -> list:
@@ -88,10 +96,9 @@ class Registry(Mapping[str, Entry]):
             except ImportError as exc:
                 self.unavailable[module.name] = f"missing dependency: {exc}"
         for point in _entry_points(group=self.package):
-            try:
-                self._plug(point.load())
-            except Exception as exc:  # a broken plugin is reported, the others still load
-                self.unavailable[point.name] = f"plugin {point.value}: {type(exc).__name__}: {exc}"
+            reason = self._plug_guarded(point)
+            if reason:
+                self.unavailable[point.name] = f"plugin {point.value}: {reason}"
 
     def _load_one(self, name: str) -> None:
         """Import the built-in module called ``name``, or the plugin of that name, if any."""
@@ -105,10 +112,30 @@ class Registry(Mapping[str, Entry]):
         except ImportError:
             return  # the full load records why
         for point in _entry_points(group=self.package, name=name):
-            try:
+            if self._plug_guarded(point):
+                return  # the full load records why
+
+    def _plug_guarded(self, point: Any) -> str:
+        """Load and register the entry point ``point``; why it failed, or '' when it did not.
+
+        A plugin's import is bounded by `PLUGIN_IMPORT_S` and may neither end the command
+        (`SystemExit`) nor pass its own `KeyboardInterrupt` off as the user's.
+        """
+        before = user_interrupts()
+        try:
+            with alarm(PLUGIN_IMPORT_S):
                 self._plug(point.load())
-            except Exception:  # the full load records why
-                return
+        except BudgetExceeded:
+            return f"its import took longer than {PLUGIN_IMPORT_S:g} s and was stopped"
+        except SystemExit as exc:
+            return f"its import called sys.exit({exc.code!r})"
+        except KeyboardInterrupt:
+            if from_user(before):
+                raise
+            return "its import raised KeyboardInterrupt"
+        except Exception as exc:  # a broken plugin is reported, the others still load
+            return f"{type(exc).__name__}: {exc}"
+        return ""
 
     def _plug(self, loaded: object) -> None:
         """Register what an entry point names: a module registered itself on import."""

@@ -18,7 +18,8 @@ from typing import TYPE_CHECKING, Any, Protocol
 from lawbench.core.case import CASES, Case
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.law import LAWS, Law, alarm
+from lawbench.core.guards import alarm, watch_interrupts
+from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.transforms import apply
@@ -158,8 +159,10 @@ def make_trial(
     settings : mapping, optional
         Settings of the checks that solve again, carried by the trial.
     max_seconds : float, optional
-        A wall-clock bound on the whole call, kept from outside the law's own budget
-        (`lawbench.core.law.alarm`): it stops a law that ignores its ``max_seconds``.
+        A wall-clock bound on the whole call. Whether given or not, the call is stopped from
+        outside (`lawbench.core.guards.alarm`) once the law's own ``max_seconds`` and
+        `OUTSIDE_GRACE_S` have passed, whatever the law does, so that a law that ignores its
+        budget still ends with `BudgetExceeded`.
 
     Returns
     -------
@@ -173,8 +176,22 @@ def make_trial(
     NotApplicable, SolverFailure
         As the law's solve raises them.
     """
-    with alarm(max_seconds):
-        return _trial(_law(law), source, params, dict(options or {}), transform, settings)
+    law = _law(law)
+    options = dict(options or {})
+    watch_interrupts()
+    with alarm(_outside_bound(law, options, max_seconds)):
+        return _trial(law, source, params, options, transform, settings)
+
+
+# Seconds past a law's own ``max_seconds`` before the guard from outside stops it: the law's
+# budget, which says what it ran out of, speaks first.
+OUTSIDE_GRACE_S = 1.0
+
+
+def _outside_bound(law: Law, options: dict[str, Any], max_seconds: float | None) -> float:
+    """The wall-clock bound of a solve: the law's ``max_seconds`` and grace, or ``max_seconds``."""
+    own = law.option_values(options)["max_seconds"] + OUTSIDE_GRACE_S
+    return own if max_seconds is None else min(own, max_seconds)
 
 
 def _trial(

@@ -9,9 +9,11 @@ Two forms, one rule: a job that has not answered after its budget is stopped and
   caller even inside compiled code; a worker that dies is replaced the same way, and a worker
   ends with the process that started it (no orphan keeps computing). Warnings a task raises
   are recorded with its result instead of being printed.
-- `lawbench.core.law.alarm` guards a job in this process (the serial executor, ``lawbench
-  solve --max-seconds``): a timer signal raises the `BudgetExceeded` inside the job. It
-  interrupts Python code only, and only in the main thread.
+- `lawbench.core.guards.alarm` guards a job in this process (the serial executor, every
+  `lawbench.core.trial.make_trial`): a timer signal raises the `BudgetExceeded` inside the
+  job. It interrupts Python code, and native code when it returns, only in the main thread;
+  ``lawbench solve`` and ``lawbench check`` end their own process when a native call overstays
+  it (`lawbench.core.guards.end_process_when_stuck`).
 """
 
 from __future__ import annotations

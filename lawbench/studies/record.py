@@ -22,7 +22,7 @@ import numpy as np
 
 from lawbench.checks import CheckResult
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
-from lawbench.core.law import WALL_CLOCK
+from lawbench.core.guards import WALL_CLOCK
 from lawbench.core.trial import Trial
 from lawbench.core.verdicts import Verdict, of_error
 from lawbench.studies.study import Job

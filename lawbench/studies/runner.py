@@ -33,7 +33,7 @@ from tqdm import tqdm
 
 from lawbench.checks import run_checks
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.law import alarm, stopped
+from lawbench.core.guards import alarm, stopped
 from lawbench.files.paths import output_file
 from lawbench.studies.guard import (
     BUDGET_S,

@@ -7,6 +7,7 @@ import sys
 
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.guards import end_process_when_stuck
 from lawbench.core.law import LAWS, Law
 from lawbench.views.cli.main import MAX_REPEATS, CheckFailed, _count, _names
 
@@ -32,8 +33,14 @@ def arguments(check: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> None:
-    """Print the law's conformance table; raise `CheckFailed` when it does not pass."""
+    """Print the law's conformance table; raise `CheckFailed` when it does not pass.
+
+    Every solve is bounded from outside (`lawbench.core.trial.make_trial`); a law stuck in
+    native code past that bound ends this command (`lawbench.core.guards.end_process_when_stuck`).
+    """
     from lawbench.studies.conformance import check_law
+
+    end_process_when_stuck()
 
     cases = _names(args.cases, "--cases", CASES)
     report = check_law(_law_object(args.law), cases=cases, random_problems=args.random)

@@ -20,6 +20,7 @@ from lawbench.core.errors import (
     NotApplicable,
     SolverFailure,
 )
+from lawbench.core.guards import watch_interrupts
 from lawbench.core.registry import Registry
 from lawbench.studies.guard import BUDGET_S, EXECUTORS
 
@@ -224,11 +225,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     # The run machinery reports damaged chunks through logging: one line on stderr each.
     logging.basicConfig(format="lawbench: %(message)s", level=logging.WARNING)
+    watch_interrupts()
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         args = build_parser(_command(argv)).parse_args(argv)
     except SystemExit as exit_:  # usage errors and --help
         return int(exit_.code or 0)
+    except MemoryError:
+        return _out_of_memory()
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -242,6 +246,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
     except BrokenPipeError:
         return 0
+    except MemoryError:
+        return _out_of_memory()
     except KeyboardInterrupt:
         print(
             "lawbench: interrupted; finished rows are kept (rerun with --resume)", file=sys.stderr
@@ -251,6 +257,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"lawbench: internal error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
         return 1
     return 0
+
+
+def _out_of_memory() -> int:
+    """One line and a solver failure's exit code: the work needed more memory than it got."""
+    print("lawbench: out of memory (MemoryError)", file=sys.stderr)
+    return EXIT_CODES[SolverFailure]
 
 
 def _one_line(message: object) -> str:

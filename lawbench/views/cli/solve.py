@@ -12,8 +12,10 @@ import numpy as np
 
 from lawbench.checks import CheckResult, run_checks
 from lawbench.core.contact import ContactProblem, ContactSolution
-from lawbench.core.errors import InvalidProblem
+from lawbench.core.errors import InvalidProblem, SolverFailure
+from lawbench.core.guards import end_process_when_stuck
 from lawbench.core.trial import Trial, make_trial
+from lawbench.core.verdicts import Verdict
 from lawbench.files.facts import ProblemFile
 from lawbench.views.cli.main import _assignments, _path, _seconds, add_assignments
 
@@ -52,7 +54,12 @@ def arguments(solve: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> None:
-    """Solve, then print the record (text, or one JSON object under ``--json``)."""
+    """Solve, then print the record (text, or one JSON object under ``--json``).
+
+    The solve is bounded from outside (`lawbench.core.trial.make_trial`); a law stuck in
+    native code past that bound ends this command (`lawbench.core.guards.end_process_when_stuck`).
+    """
+    end_process_when_stuck()
     case, params = _scene_or_problem(args)
     options = _assignments(args.option, "--option")
     if isinstance(case, ProblemFile) and isinstance(case.problem, ContactProblem):
@@ -98,10 +105,26 @@ def _solve(
         transform=args.transform or "",
         max_seconds=args.max_seconds,
     )
-    record = trial_record(trial, run_checks(trial))
+    checks = run_checks(trial)
+    _refuse_broken_promises(trial, checks)
+    record = trial_record(trial, checks)
     if isinstance(case, ProblemFile):
         record["diagnostics"].update(case.facts.diagnostics(trial.outcome))
     return record
+
+
+def _refuse_broken_promises(trial: Trial, checks: dict[str, CheckResult]) -> None:
+    """Raise `SolverFailure` when a check fails where the law or every law promises it holds.
+
+    Such an answer (a numerical failure: a guarantee of the law, or admissibility, impulse
+    sign, friction cone, momentum or a reference) is never shown with the status ok.
+    """
+    for name, result in checks.items():
+        if result.verdict == Verdict.NUMERICAL_FAILURE:
+            promise = f" ({result.claim.describe()})" if result.claim else ""
+            raise SolverFailure(
+                f"{trial.law.name}: {name} fails where it must hold{promise}: {result.detail}"
+            )
 
 
 def _print_record(record: dict) -> None:

@@ -1,0 +1,269 @@
+"""What lawbench holds a law's code to, from outside it: time, Ctrl-C, and its answer.
+
+A law is code from anywhere (a plugin, a user's module), so nothing here trusts it.
+
+`alarm` raises `stopped` inside the enclosed code once its seconds have passed, whatever that
+code does, as long as it runs Python or returns to it: a timer signal (SIGALRM) interrupts a
+sleep, a Python loop, and a native call at its return. Alarms nest: an inner one never delays
+an outer one, and the outer one rings with its own message. A native call that does not return
+(a long LAPACK factorization, code that blocks the signal) is stopped by a process boundary
+instead: the study runner's worker processes (`lawbench.studies.guard`), or, in a command that
+calls `end_process_when_stuck` (``lawbench solve``, ``lawbench check``), a watchdog thread that
+ends the process with one line and exit code 4 `LAST_RESORT_S` seconds after an alarm's
+deadline. The watchdog runs while the native call releases the interpreter's lock, as numpy's
+linear algebra and every blocking system call do; a native loop that holds the lock can only
+be stopped from another process.
+
+`user_interrupts` counts the SIGINTs the user sends while lawbench watches them, so that a
+`KeyboardInterrupt` raised by a law's own code (a failure of that law) is told apart from the
+user's Ctrl-C (which still ends the command): `from_user` states the rule.
+
+`inputs` digests what a law receives, so that a law that writes into its problem or its options
+is caught; `verify_answer` refuses an answer of the wrong type or shape, a non-finite number,
+and reported energies or impulses that are not those of the answer's own velocities. Each
+raises `SolverFailure` naming the law.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import threading
+import time
+import zlib
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import numpy as np
+
+from lawbench.core.errors import BudgetExceeded, SolverFailure
+from lawbench.core.metric import all_finite
+from lawbench.core.outcome import Outcome, generalized_impulse
+from lawbench.core.problem import ImpactProblem
+
+# The budget that a stop from outside the solve names.
+WALL_CLOCK = "wall-clock guard"
+
+
+def stopped(seconds: float) -> BudgetExceeded:
+    """The error of a job stopped by the guard after ``seconds``."""
+    return BudgetExceeded(
+        f"no answer within {seconds:g} s: stopped by the {WALL_CLOCK}", WALL_CLOCK, seconds, seconds
+    )
+
+
+def in_main_thread() -> bool:
+    """Whether this is the main thread, the only one that receives signals."""
+    return threading.current_thread() is threading.main_thread()
+
+
+# The longest alarm: the system's timer takes no more, and a budget of a year is no bound.
+ALARM_LIMIT_S = 3.0e7
+
+
+@contextmanager
+def alarm(seconds: float | None) -> Iterator[None]:
+    """Raise `stopped` inside the enclosed code once ``seconds`` have passed.
+
+    No guard when ``seconds`` is None, beyond `ALARM_LIMIT_S`, or outside the main thread
+    (signals reach only it).
+    Inside another alarm the timer rings at the earlier of the two deadlines, and the outer
+    alarm's deadline is restored on the way out.
+    """
+    if not seconds or seconds > ALARM_LIMIT_S or not in_main_thread():
+        yield
+        return
+    watched = _Watchdog.watch(seconds)
+    outer = signal.getsignal(signal.SIGALRM)
+    outer_left = signal.getitimer(signal.ITIMER_REAL)[0]
+    start = time.monotonic()
+    outer_first = 0 < outer_left <= seconds
+
+    def ring(signum: int, frame: Any) -> None:
+        if outer_first and callable(outer):
+            outer(signum, frame)
+        raise stopped(seconds)
+
+    signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, outer_left if outer_first else seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, outer)
+        _Watchdog.deadline = watched
+        if outer_left > 0:
+            # An outer deadline already past rings at once, in the outer alarm's own words.
+            left = outer_left - (time.monotonic() - start)
+            signal.setitimer(signal.ITIMER_REAL, max(left, 1e-6))
+
+
+# Seconds past an alarm's deadline before the watchdog of `end_process_when_stuck` ends the
+# process: the alarm's own error, raised once the native call returns, is the clearer answer.
+LAST_RESORT_S = 2.0
+# Exit code of a process the watchdog ends: a solver failure's, as the command line gives it.
+STUCK_EXIT = 4
+
+
+class _Watchdog:
+    """The deadline of the innermost alarm (None: no alarm open) and the thread that keeps it."""
+
+    deadline: float | None = None
+    thread: threading.Thread | None = None
+
+    @classmethod
+    def watch(cls, seconds: float) -> float | None:
+        """Set the deadline of an alarm of ``seconds`` from now; return the one it replaces."""
+        previous = cls.deadline
+        if cls.thread is not None:
+            deadline = time.monotonic() + seconds + LAST_RESORT_S
+            cls.deadline = deadline if previous is None else min(previous, deadline)
+        return previous
+
+    @classmethod
+    def keep(cls) -> None:
+        while True:
+            time.sleep(0.1)
+            deadline = cls.deadline
+            if deadline is not None and time.monotonic() > deadline:
+                os.write(
+                    2,
+                    f"lawbench: the solve did not return to Python {LAST_RESORT_S:g} s after its "
+                    f"wall-clock budget (stopped by the {WALL_CLOCK}; the process ends)\n".encode(),
+                )
+                os._exit(STUCK_EXIT)
+
+
+def end_process_when_stuck() -> None:
+    """From now on, end this process when a solve overstays an `alarm` inside native code.
+
+    For a command line that runs the solves of one user's request: ending it is then what a
+    subprocess guard would do, without the cost of starting one per solve.
+    """
+    if _Watchdog.thread is None:
+        _Watchdog.thread = threading.Thread(target=_Watchdog.keep, daemon=True)
+        _Watchdog.thread.start()
+
+
+class _Interrupts:
+    """The SIGINTs received while lawbench's handler is installed (see `user_interrupts`)."""
+
+    count = 0
+
+    @staticmethod
+    def handler(signum: int, frame: Any) -> None:
+        _Interrupts.count += 1
+        signal.default_int_handler(signum, frame)
+
+
+def watch_interrupts() -> None:
+    """Count the user's Ctrl-C from now on, where Python's own handler would take it.
+
+    The handler still raises `KeyboardInterrupt`; a handler of the caller's (or SIGINT
+    ignored, as in a guarded worker) is left as it is.
+    """
+    if in_main_thread() and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _Interrupts.handler)
+
+
+def user_interrupts() -> int:
+    """SIGINTs counted so far (while watched): read before the code that may be interrupted."""
+    return _Interrupts.count
+
+
+def from_user(before: int) -> bool:
+    """Whether a `KeyboardInterrupt` caught now is the user's Ctrl-C.
+
+    ``before`` is `user_interrupts` when the code that raised it began. The rule: outside the
+    main thread, or where SIGINT is ignored (a guarded worker), no signal raises it, so the code
+    raised it itself; otherwise it is the user's when a SIGINT arrived meanwhile, or when
+    SIGINTs are not watched (then lawbench cannot tell, and lets it end the command).
+    """
+    handler = signal.getsignal(signal.SIGINT)
+    if not in_main_thread() or handler == signal.SIG_IGN:
+        return False
+    return handler is not _Interrupts.handler or _Interrupts.count != before
+
+
+# Relative disagreement, beyond rounding, between the numbers a law reports and its velocities:
+# an energy against ``v @ M @ v / 2``, and ``Wn Pn + Wt Pt`` against ``M (v+ - v-)``, each
+# relative to the energies or momenta it is computed from. The built-in laws agree to 1e-15 on
+# every scene; the margin is for ``M^-1`` applied to an ill-conditioned mass matrix.
+CONSISTENCY = 1e-7
+
+
+def _checksum(arrays: tuple[Any, ...]) -> int:
+    """One checksum of the numbers of numpy arrays and scipy.sparse matrices (None skipped)."""
+    crc = 0
+    for array in arrays:
+        if array is None:
+            continue
+        parts = (array,) if isinstance(array, np.ndarray) else _sparse_parts(array)
+        for part in parts:
+            crc = zlib.crc32(part if part.flags.c_contiguous else part.copy(), crc)
+    return crc
+
+
+def _sparse_parts(matrix: Any) -> tuple[np.ndarray, ...]:
+    return tuple(getattr(matrix, name) for name in ("data", "indices", "indptr"))
+
+
+def inputs(problem: ImpactProblem, options: dict[str, Any]) -> tuple[tuple, tuple]:
+    """A digest of what a law receives, to compare before and after its solve."""
+    arrays = (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps)
+    try:
+        contacts: object = hash(tuple(problem.contacts))
+    except TypeError:  # a contact given an unhashable field
+        contacts = repr(problem.contacts)
+    return (*map(id, arrays), _checksum(arrays), contacts), (*options, *map(id, options.values()))
+
+
+def verify_answer(law: str, problem: ImpactProblem, outcome: Any) -> None:
+    """Raise `SolverFailure` unless ``outcome`` answers ``problem`` in shape and numbers.
+
+    Its fields have the problem's lengths, and its reported energies and impulses are those
+    of its own velocities.
+    """
+    if not isinstance(outcome, Outcome):
+        raise SolverFailure(f"{law}: the law returned a {type(outcome).__name__}, not an Outcome")
+    v_plus, Pn, Pt = outcome.v_plus, outcome.Pn, outcome.Pt
+    n, m, md = problem.n, problem.m, problem.m * problem.d
+    if np.shape(v_plus) != (n,) or np.shape(Pn) != (m,) or np.shape(Pt) not in ((md,), (0,)):
+        for field, length in (("v_plus", n), ("Pn", m), ("Pt", md)):
+            shape = np.shape(getattr(outcome, field))
+            if shape != (length,) and not (field == "Pt" and shape == (0,)):
+                raise SolverFailure(f"{law}: {field} has shape {shape}, expected ({length},)")
+    after, before = problem.M.dot(v_plus), problem.M.dot(problem.v)
+    impulse = generalized_impulse(problem, Pn, Pt)
+    residual = impulse - (after - before)
+    T_plus, told_minus, told_plus = float(v_plus.dot(after)) / 2, outcome.T_minus, outcome.T_plus
+    # Squared 2-norms: dot products, the cheapest reductions of a small solve.
+    scale = after.dot(after) + before.dot(before) + impulse.dot(impulse)
+    if not math.isfinite(scale + told_minus + told_plus):
+        refuse_non_finite(law, v_plus=v_plus, Pn=Pn, Pt=Pt, T_plus=float(told_plus))
+        return  # finite numbers so large that their squares overflow: beyond these checks
+    for field, told, kept in (
+        ("T_minus", told_minus, problem.T_minus),
+        ("T_plus", told_plus, T_plus),
+    ):
+        if abs(told - kept) > CONSISTENCY * max(T_plus, problem.T_minus):
+            raise SolverFailure(
+                f"{law}: reports {field} = {told:.6g} J where its velocities hold {kept:.6g} J"
+            )
+    if residual.dot(residual) > CONSISTENCY**2 * scale:
+        raise SolverFailure(
+            f"{law}: its impulses Wn Pn + Wt Pt do not give its velocity change M (v+ - v-)"
+        )
+
+
+def refuse_non_finite(name: str, **fields: Any) -> None:
+    """Raise `SolverFailure` naming the first of ``fields`` that holds a non-finite number."""
+    for field, value in fields.items():
+        if isinstance(value, float):
+            finite = math.isfinite(value)
+        else:
+            finite = not value.size or all_finite(value)
+        if not finite:
+            raise SolverFailure(f"{name}: non-finite {field} {value}")

@@ -1,0 +1,339 @@
+"""Laws that misbehave: every bound holds and the checks read the velocities.
+
+A law is code from anywhere. Each test below holds one promise of `Law.resolve`, the registry
+and the command line against a law (or a plugin) written to break it: one that sleeps, loops,
+exits, interrupts, writes into its input, answers in the wrong shape, or reports numbers its
+velocities do not hold.
+"""
+
+import dataclasses
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+from test_plugins import distribution
+
+import lawbench
+from lawbench.checks import run_checks
+from lawbench.core import registry as registry_module
+from lawbench.core.errors import BudgetExceeded, SolverFailure
+from lawbench.core.guards import WALL_CLOCK, alarm
+from lawbench.core.law import Law
+from lawbench.core.registry import Registry
+from lawbench.core.trial import Trial
+from lawbench.views.cli.main import main
+
+SHORT = lawbench.Spec("max_seconds", 0.3, "wall-clock budget of one solve", unit="s", low=0.0)
+
+
+class Plain(Law):
+    """Newton's restitution at one contact, the base the broken laws start from."""
+
+    name = "plain_test_law"
+    summary = "Newton's restitution at one contact"
+    source = "Newton's law of restitution"
+    tags = lawbench.Tags()
+    options = (SHORT,)
+
+    def _resolve(self, problem, options):
+        Pn = -(1 + problem.restitution("kinematic")) * problem.un / np.diag(problem.delassus)
+        return lawbench.Outcome.from_impulses(problem, np.maximum(Pn, 0.0))
+
+
+def ball(e=0.5):
+    return lawbench.ImpactProblem.from_arrays(np.eye(1), [[1.0]], [-2.0], e=e)
+
+
+def broken(body, name="broken_test_law"):
+    """A `Plain` law whose `_resolve` is ``body``."""
+    return type("Broken", (Plain,), {"name": name, "_resolve": body})()
+
+
+def test_a_plain_law_passes_the_guards():
+    outcome = lawbench.solve(Plain(), ball())
+    assert outcome.v_plus.tolist() == [1.0]
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        pytest.param(lambda self, p, o: time.sleep(100), id="sleeps"),
+        pytest.param(lambda self, p, o: [None for _ in iter(int, 1)], id="loops"),
+    ],
+)
+def test_a_law_that_ignores_its_budget_is_stopped_from_outside(body):
+    start = time.monotonic()
+    with pytest.raises(BudgetExceeded, match=WALL_CLOCK):
+        lawbench.solve(broken(body), ball())
+    assert time.monotonic() - start < 5
+
+
+def test_an_outer_alarm_rings_first_in_its_own_words():
+    with pytest.raises(BudgetExceeded, match=r"within 0\.2 s"):
+        with alarm(0.2):
+            with alarm(30):
+                time.sleep(5)
+
+
+def _exits(self, problem, options):
+    sys.exit(0)
+
+
+def _interrupts(self, problem, options):
+    raise KeyboardInterrupt
+
+
+def _runs_out_of_memory(self, problem, options):
+    raise MemoryError
+
+
+@pytest.mark.parametrize(
+    ("body", "said"),
+    [(_exits, "sys.exit"), (_interrupts, "KeyboardInterrupt"), (_runs_out_of_memory, "memory")],
+)
+def test_exit_interrupt_and_memory_in_a_law_are_its_failure(body, said):
+    with pytest.raises(SolverFailure, match=f"broken_test_law: .*{said}"):
+        lawbench.solve(broken(body), ball())
+
+
+def test_the_users_ctrl_c_still_interrupts():
+    def pressed(self, problem, options):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(2)
+
+    with pytest.raises(KeyboardInterrupt):
+        lawbench.solve(broken(pressed), ball())
+
+
+def _writes_velocity(self, problem, options):
+    problem.v.setflags(write=True)
+    problem.v[0] = 0.0
+    problem.v.setflags(write=False)
+    return Plain._resolve(self, problem, options)
+
+
+def _writes_contact(self, problem, options):
+    object.__setattr__(problem.contacts[0], "e", 1.0)
+    return Plain._resolve(self, problem, options)
+
+
+def _writes_options(self, problem, options):
+    options["max_seconds"] = 1e9
+    return Plain._resolve(self, problem, options)
+
+
+@pytest.mark.parametrize(
+    ("body", "what"),
+    [(_writes_velocity, "problem"), (_writes_contact, "problem"), (_writes_options, "options")],
+)
+def test_a_law_that_writes_into_its_input_is_refused(body, what):
+    with pytest.raises(SolverFailure, match=f"wrote into the {what}"):
+        lawbench.solve(broken(body), ball())
+
+
+@pytest.mark.parametrize("field", ["v_plus", "Pn"])
+def test_a_wrong_output_shape_names_the_field(field):
+    def wrong(self, problem, options):
+        outcome = Plain._resolve(self, problem, options)
+        return dataclasses.replace(outcome, **{field: np.zeros(3)})
+
+    with pytest.raises(SolverFailure, match=f"{field} has shape"):
+        lawbench.solve(broken(wrong), ball())
+
+
+def _reports_less_energy(self, problem, options):
+    return dataclasses.replace(Plain._resolve(self, problem, options), T_plus=1.0)
+
+
+def _hides_a_tensile_impulse(self, problem, options):
+    outcome = lawbench.Outcome.from_impulses(problem, np.array([-1.0]))
+    return dataclasses.replace(outcome, Pn=np.abs(outcome.Pn))
+
+
+@pytest.mark.parametrize(
+    ("body", "said"),
+    [(_reports_less_energy, "T_plus = 1 J"), (_hides_a_tensile_impulse, "impulses")],
+)
+def test_reported_numbers_must_be_those_of_the_velocities(body, said):
+    with pytest.raises(SolverFailure, match=said):
+        lawbench.solve(broken(body), ball(e=1.0))
+
+
+def test_the_checks_read_the_velocities_not_the_reports():
+    """A trial built around a lying outcome (no `Law.resolve`) fails the checks it fools."""
+    problem = ball(e=1.0)
+    honest = lawbench.Outcome.from_impulses(problem, np.array([6.0]))  # v+ = 4: T+ = 8 J
+    lying = dataclasses.replace(honest, T_plus=1.0, Pn=np.array([1.0]))
+    trial = Trial(Plain(), None, {}, {}, problem, lying)
+    results = run_checks(trial, checks=["energy_gain", "impulse_sign"])
+    assert results["energy_gain"].passed is False
+    assert results["impulse_sign"].passed is False
+    assert "velocity change" in results["impulse_sign"].detail
+
+
+class _Point:
+    def __init__(self, name, load):
+        self.name, self.value, self.load = name, f"hostile:{name}", load
+
+
+def _raise(error):
+    def load():
+        raise error
+
+    return load
+
+
+def test_a_plugin_that_exits_hangs_raises_or_interrupts_at_import_is_unavailable(monkeypatch):
+    points = [
+        _Point("exits", _raise(SystemExit(3))),
+        _Point("interrupts", _raise(KeyboardInterrupt())),
+        _Point("raises", _raise(RuntimeError("no"))),
+        _Point("hangs", lambda: time.sleep(100)),
+        _Point("fine", lambda: Plain),
+    ]
+    monkeypatch.setattr(registry_module, "_entry_points", lambda **selection: points)
+    monkeypatch.setattr(registry_module, "PLUGIN_IMPORT_S", 0.3)
+    laws = Registry("law", "lawbench.laws", Law)
+    assert "plain_test_law" in laws  # the others fail, and the good one still loads
+    reasons = laws.unavailable
+    assert "sys.exit(3)" in reasons["exits"]
+    assert "KeyboardInterrupt" in reasons["interrupts"]
+    assert "RuntimeError: no" in reasons["raises"]
+    assert "longer than 0.3 s" in reasons["hangs"]
+
+
+def test_memory_error_is_one_line_and_exit_4(monkeypatch, capsys):
+    def no_memory(command=None):
+        raise MemoryError
+
+    monkeypatch.setattr(sys.modules["lawbench.views.cli.main"], "build_parser", no_memory)
+    assert main(["list"]) == 4
+    assert capsys.readouterr().err.strip() == "lawbench: out of memory (MemoryError)"
+
+
+HOSTILE = '''
+"""Laws that misbehave, for the command-line tests of lawbench's guards."""
+
+import signal
+import time
+
+import numpy as np
+
+import lawbench
+
+SHORT = lawbench.Spec("max_seconds", 0.3, "wall-clock budget of one solve", unit="s", low=0.0)
+
+
+class Sleeper(lawbench.Law):
+    name, summary, source = "sleeper", "sleeps instead of solving", "none"
+    tags, options = lawbench.Tags(), (SHORT,)
+
+    def _resolve(self, problem, options):
+        time.sleep(1000)
+
+
+class Deaf(Sleeper):
+    name = "deaf"
+    summary = "blocks the timer signal, then sleeps: a native call that never returns"
+
+    def _resolve(self, problem, options):
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGALRM})
+        time.sleep(1000)
+
+
+class BallOnWall(lawbench.Case):
+    name = "lone_ball"
+    summary = "one ball on a wall"
+    params = (lawbench.Spec("e", 0.5, "restitution", low=0.0, high=1.0),)
+    examples = {"default": {}}
+
+    def _build(self, params):
+        return lawbench.ImpactProblem.from_arrays(np.eye(1), [[1.0]], [-1.0], e=params["e"])
+
+    def coordinates(self, params):
+        return ["ball (m/s)"]
+'''
+
+EXITS = "import sys\nsys.exit(0)\n"
+INTERRUPTS = "raise KeyboardInterrupt\n"
+
+ENTRY_POINTS = """
+[lawbench.laws]
+sleeper = hostile_plugin:Sleeper
+deaf = hostile_plugin:Deaf
+exits = exits_at_import:Nothing
+interrupts = interrupts_at_import:Nothing
+
+[lawbench.cases]
+lone_ball = hostile_plugin:BallOnWall
+"""
+
+
+@pytest.fixture(scope="module")
+def hostile_env(tmp_path_factory):
+    modules = {
+        "hostile_plugin": textwrap.dedent(HOSTILE),
+        "exits_at_import": EXITS,
+        "interrupts_at_import": INTERRUPTS,
+    }
+    return distribution(tmp_path_factory.mktemp("hostile"), "hostile-plugin", modules, ENTRY_POINTS)
+
+
+def cli(env, *argv, cwd=None):
+    return subprocess.run(
+        [sys.executable, "-m", "lawbench", *argv],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=cwd,
+        timeout=60,
+    )
+
+
+@pytest.mark.parametrize(
+    "argv", [("list",), ("describe", "newton"), ("study", "--list")], ids=lambda a: a[0]
+)
+def test_the_built_in_commands_work_beside_plugins_broken_at_import(hostile_env, argv):
+    done = cli(hostile_env, *argv)
+    assert done.returncode == 0, done.stderr
+    if argv == ("list",):
+        assert "sys.exit(0)" in done.stdout and "KeyboardInterrupt" in done.stdout
+
+
+@pytest.mark.parametrize("law", ["sleeper", "deaf"])
+def test_solve_stops_a_law_that_never_answers(hostile_env, law):
+    start = time.monotonic()
+    done = cli(hostile_env, "solve", law, "lone_ball")
+    assert done.returncode == 4, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and WALL_CLOCK in done.stderr
+    assert time.monotonic() - start < 20
+
+
+def test_check_and_run_stop_a_law_that_sleeps(hostile_env, tmp_path):
+    checked = cli(hostile_env, "check", "sleeper", "--cases", "lone_ball", "--random", "0")
+    assert "budget" in checked.stdout and "Traceback" not in checked.stderr
+    ran = cli(
+        hostile_env,
+        *("run", "--laws", "sleeper", "--cases", "lone_ball", "--executor", "serial"),
+        *("--out", "run.csv", "--format", "csv"),
+        cwd=tmp_path,
+    )
+    assert ran.returncode == 0, ran.stderr
+    assert WALL_CLOCK in (tmp_path / "run.csv").read_text()
+
+
+def test_an_answer_that_breaks_a_promise_is_a_solver_failure_never_ok():
+    """A contact left approaching (a promise of every law) ends ``lawbench solve``, exit 4."""
+    from lawbench.views.cli.solve import _refuse_broken_promises
+
+    def pulls(self, problem, options):
+        return lawbench.Outcome.from_impulses(problem, np.array([-1.0]))
+
+    trial = lawbench.evaluate(broken(pulls), ball())
+    with pytest.raises(SolverFailure, match="admissible fails where it must hold"):
+        _refuse_broken_promises(trial, run_checks(trial))
