@@ -74,11 +74,10 @@ frictionless formulations above do not depend on it:
   is at most ``tol``; a sweep is one of the ``max_steps`` steps. ``polish`` then refines the
   answer on its contact states and keeps the refinement where its FC3D error is no larger.
   An iteration that becomes stationary above ``tol`` raises `SolverFailure`. It solves Coulomb's
-  law only: with ``friction="relaxed"`` it raises `InvalidProblem`, Anitescu's convex problem
-  being the fixed point's. Far cheaper per step than a cone QP, it can stall on granular
-  problems whose Delassus matrix is singular (more contact directions than coordinates), where
-  the fixed point's interior-point steps still find the contact states. Diagnostics:
-  ``sweeps`` (and ``iterations``, the same), ``polished``, ``fc3d_error``.
+  law only (``friction="relaxed"`` raises `InvalidProblem`). Far cheaper per step than a cone
+  QP, it can stall where the Delassus matrix is singular (more contact directions than
+  coordinates), where the fixed point's interior-point steps still find the contact states.
+  Diagnostics: ``sweeps`` (and ``iterations``, the same), ``polished``, ``fc3d_error``.
 - ``auto`` (default): the fixed point on an impact of at most ``FIXED_POINT_MAX`` contacts,
   where a cone QP is cheap and settles the cases of several solutions; Gauss-Seidel with the
   polish on a larger impact and in contact space, then the fixed point where the sweeps become

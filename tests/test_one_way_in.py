@@ -17,11 +17,11 @@ from lawbench.views.cli import main
 SOLVE = ["solve", "moreau", "three_ball_chain", "--set", "e=0.5"]
 # The modules whose functions a solve of one law on one scene may call, at most: the command
 # and its parser (2); the entry point, the scene's parameters, their specs and the registry (4);
-# the problem, its matrices and kinetic metric, its units (3); the law with its budget, its
+# the problem, and its matrices, kinetic metric and units (2); the law with its budget, its
 # outcome and its solver (4: the law's module, the outcome, the solver, the law protocol); the
 # scene and the chain scenes' shared module (2); the checks (1); the guards a law's code is held
 # to from outside it, its time, Ctrl-C and the honesty of its answer (1).
-MAX_MODULES = 17
+MAX_MODULES = 16
 
 
 def _importing(frame: FrameType | None) -> bool:

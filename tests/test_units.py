@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import lawbench
+from lawbench.core.metric import UNIT_BAND
 from lawbench.core.problem import ImpactProblem
-from lawbench.core.units import UNIT_BAND
 
 SCALED_LAWS = [name for name in lawbench.LAWS.names() if lawbench.LAWS.get(name).scale_free]
 SCENES = ("three_ball_chain", "two_balls_wall", "rocking_block", "billiard", "lamina")

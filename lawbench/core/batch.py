@@ -25,9 +25,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.metric import all_finite
+from lawbench.core.metric import UNIT_BAND, all_finite
 from lawbench.core.problem import CONTACT_RANGES, RESTITUTION_FIELDS, Contact, ImpactProblem
-from lawbench.core.units import UNIT_BAND
 
 if TYPE_CHECKING:
     import pandas as pd

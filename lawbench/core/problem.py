@@ -4,9 +4,8 @@ Sign conventions, used everywhere in lawbench: the gap rate of contact j is
 ``un[j] = Wn[:, j] @ v``; ``un < 0`` approaches and ``un > 0`` separates. Normal impulses
 ``Pn >= 0`` push the bodies apart, and ``v_plus = v + M^-1 (Wn @ Pn + Wt @ Pt)``.
 
-This module holds the problem's fields and their checks; the mass matrix's factor and the
-Delassus matrices are `lawbench.core.metric`'s, the units a problem is solved in
-`lawbench.core.units`'.
+This module holds the problem's fields and their checks; its checked arrays, the mass matrix's
+factor, the Delassus matrices and the units a problem is solved in are `lawbench.core.metric`'s.
 """
 
 from __future__ import annotations
@@ -28,11 +27,12 @@ from lawbench.core.metric import (
     KineticMetric,
     checked_matrix,
     checked_sparse_matrix,
+    in_units,
     is_sparse,
     kinetic_energy,
     read_only_finite,
+    solving_units,
 )
-from lawbench.core.units import in_units, solving_units
 
 # The kinds of restitution coefficient and the contact field that overrides ``e`` for each:
 # Newton's kinematic, Poisson's kinetic, Stronge's energetic coefficient.
@@ -526,7 +526,7 @@ class ImpactProblem:
         """The units of mass, velocity and time a scale-free law solves this problem in.
 
         Powers of two near the heaviest diagonal entry of M and the fastest component of v
-        (`lawbench.core.units.solving_units`): rescaling by them rounds nothing, and masses of
+        (`lawbench.core.metric.solving_units`): rescaling by them rounds nothing, and masses of
         1e-308 kg or speeds of 1e-300 m/s come near 1, where the laws' linear algebra and
         integrators neither under- nor overflow.
 
@@ -541,7 +541,7 @@ class ImpactProblem:
     def in_units(self, mass: float, velocity: float, time: float) -> ImpactProblem:
         """The problem with masses, velocities and times in units ``mass``, ``velocity``, ``time``.
 
-        See `lawbench.core.units.in_units`.
+        See `lawbench.core.metric.in_units`.
         """
         return in_units(self, mass, velocity, time)
 

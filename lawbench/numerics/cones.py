@@ -32,7 +32,7 @@ import scipy.sparse
 from lawbench.core.errors import SolverFailure
 from lawbench.core.law import current_budget
 from lawbench.core.mechanics import project
-from lawbench.core.units import binary_scale
+from lawbench.core.metric import binary_scale
 from lawbench.numerics.solvers import clarabel_settings
 
 NEWTON_STEPS = 30
