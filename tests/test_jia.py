@@ -508,3 +508,12 @@ def test_two_springs_on_one_degree_of_freedom_end_compression_together(mass):
     outcome = lawbench.solve("jia", p)
     assert outcome.v_plus == pytest.approx([-0.67196848], rel=1e-6)
     assert (outcome.Pn >= 0).all()
+
+
+def test_double_pendulum_is_continuous_as_mu_vanishes():
+    # The stretch of the tangential springs is resolved at the scale of its stick bound, so a
+    # tiny mu neither chatters between stick and slip nor leaves the frictionless answer.
+    frictionless = lawbench.solve("jia", "double_pendulum", mu=0.0).v_plus
+    for mu in (1e-8, 1e-6):
+        v_plus = lawbench.solve("jia", "double_pendulum", mu=mu).v_plus
+        assert v_plus == pytest.approx(frictionless, rel=1e-5)

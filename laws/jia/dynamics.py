@@ -188,12 +188,21 @@ class SpringImpact:
         approach = float(np.abs(u_minus[: self.m]).max())
         impulse = approach / float(np.diag(G)[: self.m].max())
         rate = float(np.abs(u_minus).max())
+        energy = math.sqrt(impulse * approach)
+        # A spring's stretch never exceeds its stick bound, 2 mu eta0^2 y / sqrt(kappa0) at
+        # most: the tolerance resolves it at that scale, so that as mu -> 0 the integration's
+        # error in the stretch stays a fixed fraction of the bound and the stick margin keeps
+        # its sign (at the scale of the slip distance it would be all rounding and the
+        # contact would chatter between stick and slip).
+        bound = 2.0 * springs.mu * springs.eta0_sq * energy / np.sqrt(self.kappa0)
+        travel = rate * self.time_scale
+        stretch = np.where(self.rough, np.minimum(bound, travel), travel)
         self.scale = np.concatenate(
             [
                 np.full(self.m, impulse),
-                np.full(self.m, math.sqrt(impulse * approach)),
+                np.full(self.m, energy),
                 np.full(self.nt, impulse),
-                np.full(self.nt, rate * self.time_scale),
+                np.repeat(stretch, self.d),
             ]
         )
 
@@ -489,7 +498,10 @@ class SpringImpact:
             self.direction[j] = self._ghat(j, self._tangential(s[self.g], j))
         else:
             self.stick[j] = True
-            self.excess[j] = max(self._stick_margin(j, s), 0.0)
+            # The slip function starts below its zero by the integration's error in the
+            # stretch, so that rounding cannot fire it at once.
+            allowance = self.tolerance * self.scale[self.g][j * self.d]
+            self.excess[j] = max(self._stick_margin(j, s) + allowance, 0.0)
         return s
 
     def _expansion(self, j: int) -> tuple[np.ndarray, float]:
