@@ -496,3 +496,24 @@ def test_stiff_contact_in_an_inelastic_chain_tends_to_one_limit():
         np.testing.assert_allclose(answer, answers[0], atol=1e-5)
     lzb = lawbench.solve("lzb", "three_ball_chain", stiffness_ratio=1e-6, e=0.5, exponent=1.0)
     np.testing.assert_allclose(answers[0], lzb.v_plus, atol=1e-4)
+
+
+@pytest.mark.parametrize("mass", [0.2, 1.0, 5.0])
+def test_two_springs_on_one_degree_of_freedom_end_compression_together(mass):
+    # Both gap rates are multiples of the one velocity: both springs end compression at one
+    # instant, whatever the unit of mass.
+    p = lawbench.ImpactProblem.from_arrays(
+        mass * np.eye(1), [[-0.819647, -2.492872]], v=[1.0], e=[0.46, 0.691]
+    )
+    outcome = lawbench.solve("jia", p)
+    assert outcome.v_plus == pytest.approx([-0.67196848], rel=1e-6)
+    assert (outcome.Pn >= 0).all()
+
+
+def test_double_pendulum_is_continuous_as_mu_vanishes():
+    # The stretch of the tangential springs is resolved at the scale of its stick bound, so a
+    # tiny mu neither chatters between stick and slip nor leaves the frictionless answer.
+    frictionless = lawbench.solve("jia", "double_pendulum", mu=0.0).v_plus
+    for mu in (1e-8, 1e-6):
+        v_plus = lawbench.solve("jia", "double_pendulum", mu=mu).v_plus
+        assert v_plus == pytest.approx(frictionless, rel=1e-5)

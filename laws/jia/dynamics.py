@@ -78,6 +78,9 @@ ROUNDING = 1e-12
 NOT_APPROACHING = 1e-2
 # A contact this much stiffer than the softest other loaded spring is rigid (see above).
 LOCK = 1e6
+# Transitions whose roots lie closer than this many natural periods are one instant: the
+# roots of dependent gap rates agree to Brent's relative rounding, not exactly.
+SIMULTANEOUS = 1e-9
 # A segment with no event within this many natural periods does not end.
 PERIODS = 1e4
 
@@ -185,12 +188,21 @@ class SpringImpact:
         approach = float(np.abs(u_minus[: self.m]).max())
         impulse = approach / float(np.diag(G)[: self.m].max())
         rate = float(np.abs(u_minus).max())
+        energy = math.sqrt(impulse * approach)
+        # A spring's stretch never exceeds its stick bound, 2 mu eta0^2 y / sqrt(kappa0) at
+        # most: the tolerance resolves it at that scale, so that as mu -> 0 the integration's
+        # error in the stretch stays a fixed fraction of the bound and the stick margin keeps
+        # its sign (at the scale of the slip distance it would be all rounding and the
+        # contact would chatter between stick and slip).
+        bound = 2.0 * springs.mu * springs.eta0_sq * energy / np.sqrt(self.kappa0)
+        travel = rate * self.time_scale
+        stretch = np.where(self.rough, np.minimum(bound, travel), travel)
         self.scale = np.concatenate(
             [
                 np.full(self.m, impulse),
-                np.full(self.m, math.sqrt(impulse * approach)),
+                np.full(self.m, energy),
                 np.full(self.nt, impulse),
-                np.full(self.nt, rate * self.time_scale),
+                np.repeat(stretch, self.d),
             ]
         )
 
@@ -342,6 +354,7 @@ class SpringImpact:
             "DOP853",
             self.tolerance,
             self.tolerance * self.scale,
+            simultaneous=SIMULTANEOUS * self.time_scale,
             past=False,
         )
         tau, s = 0.0, np.zeros(2 * (self.m + self.nt))
@@ -368,12 +381,19 @@ class SpringImpact:
                     "does not end"
                 )
             tau, s = event.x, event.y.copy()
-            # One transition at a time: the first. A spring that empties with it, a contact
-            # that then approaches or a lock that then pulls is settled at the restart; an
-            # event function another transition leaves past its zero is armed again from there.
-            name, j = armed[event.fired[0]][:2]
-            s = self._apply(name, j, s)
-            self._note_state(tau, s, [name])
+            # Transitions that coincide are applied together, in the order of their roots:
+            # contacts whose gap rates are dependent (two springs on one degree of freedom)
+            # end compression at one instant, and the root of one leaves the others' functions
+            # a rounding past their zeros, where their own events could no longer fire. One
+            # that an earlier transition of the same instant disarmed is dropped; a spring
+            # that empties with them, a contact that then approaches or a lock that then pulls
+            # is settled at the restart.
+            fired = []
+            for name, j, direction in (armed[i] for i in event.fired):
+                if (name, j, direction) in self._events():
+                    s = self._apply(name, j, s)
+                    fired.append(name)
+            self._note_state(tau, s, fired)
 
     def _on_step(self, dense: Callable[[float], np.ndarray], tau_old: float, tau: float) -> None:
         self.record.steps += 1
@@ -428,6 +448,11 @@ class SpringImpact:
                 self.kappa[j] /= e * e
             stiff = self._stiffest_ratio(j) > LOCK
             negligible = y * y <= self.tolerance * self.scale[m] ** 2
+            direction, compliance = self._expansion(j) if stiff else (None, 0.0)
+            # A stiff spring whose expansion the locked contacts hold entirely (they share its
+            # degree of freedom: the compliance along the expansion vanishes) cannot give its
+            # energy back to the bodies before the others move: it locks with them.
+            negligible |= stiff and compliance <= ROUNDING * float(self.G[j, j])
             if (e == 0 or stiff) and self.rough.any() and m > 1:
                 raise NotApplicable(
                     f"jia: contact {j} turns rigid (e = 0, or {LOCK:g} times stiffer than the "
@@ -444,12 +469,6 @@ class SpringImpact:
                 # The expansion is over before the softer springs move: the spring alone, with
                 # the locked contacts holding their gap rates, gives back E = (e y)^2 to the
                 # bodies through the impulse direction dI, an impulse e y sqrt(2 / dI.G.dI).
-                direction = np.zeros(m)
-                direction[j] = 1.0
-                if self.locked.any():
-                    self.lock = self._lock_map()
-                    direction[self.locked] = self.lock @ direction
-                compliance = float(direction @ self.G[:m, :m] @ direction)
                 s[:m] += direction * (e * y * math.sqrt(2.0 / compliance))
                 s = self._apply("separation", j, s)
         elif name == "recompression":
@@ -479,8 +498,23 @@ class SpringImpact:
             self.direction[j] = self._ghat(j, self._tangential(s[self.g], j))
         else:
             self.stick[j] = True
-            self.excess[j] = max(self._stick_margin(j, s), 0.0)
+            # The slip function starts below its zero by the integration's error in the
+            # stretch, so that rounding cannot fire it at once.
+            allowance = self.tolerance * self.scale[self.g][j * self.d]
+            self.excess[j] = max(self._stick_margin(j, s) + allowance, 0.0)
         return s
+
+    def _expansion(self, j: int) -> tuple[np.ndarray, float]:
+        """Contact j's expansion alone: its impulse direction and the compliance along it.
+
+        The locked contacts hold their gap rates; the compliance is ``dI.G.dI``.
+        """
+        direction = np.zeros(self.m)
+        direction[j] = 1.0
+        if self.locked.any():
+            self.lock = self._lock_map()
+            direction[self.locked] = self.lock @ direction
+        return direction, float(direction @ self.G[: self.m, : self.m] @ direction)
 
     def _note_state(self, tau: float, s: np.ndarray, fired: list[str]) -> None:
         """Record the events at ``tau`` and the state (several contacts) or mode that follows."""
