@@ -297,7 +297,8 @@ class Moreau(Law):
         """
         if options["method"] == "nsgs":
             self._refuse_relaxed_nsgs(options)
-            return _nsgs(problem.W, problem.q, problem.mu, problem.dim, options)
+            r, diagnostics = _nsgs(problem.W, problem.q, problem.mu, problem.dim, options)
+            return _leaving(problem, r, options["tol"]), diagnostics
         if options["friction"] == "relaxed" and problem.asymmetry > 0.0:
             raise NotApplicable(
                 f"moreau: Anitescu's relaxation is one convex problem only for a symmetric W; "
@@ -309,12 +310,12 @@ class Moreau(Law):
         P, diagnostics = _fixed_point(G, problem.q[back], problem.mu, d, options)
         r = P[local_order(m, d)]
         error = problem.error(r)
-        if error > options["tol"]:
+        if not error <= options["tol"]:  # a NaN error is no answer either
             raise SolverFailure(
                 f"moreau: the fixed point settled after {diagnostics['fixed_point_steps']} cone "
                 f"QPs at FC3D error {error:.3g} on W, above the tolerance {options['tol']:g}"
             )
-        return r, diagnostics
+        return _leaving(problem, r, options["tol"]), diagnostics
 
     def _resolve_batch(
         self, batch: ProblemBatch, options: dict[str, Any]
@@ -365,6 +366,19 @@ def _approaching(u: np.ndarray, m: int, tol: float, scale: float) -> bool:
     while the contact goes on approaching.
     """
     return bool(u[:m].min() < -(tol**0.5) * scale)
+
+
+def _leaving(problem: ContactProblem, r: np.ndarray, tol: float) -> np.ndarray:
+    """``r`` when no contact approaches after it (`_approaching`), else the exact state.
+
+    The FC3D error cannot see an approaching contact whose ``un`` the modified velocity lost
+    to rounding (``mu`` near 1e300), nor one of an answer grown far beyond ``q`` on a ``W``
+    that is not positive definite: the normal law is checked on ``u`` itself.
+    """
+    normal = problem.velocity(r)[:: problem.dim]
+    if not _approaching(normal, problem.m, tol, float(np.abs(problem.q).max())):
+        return r
+    return _one_contact_or_refuse(problem.W.toarray(), problem.q, problem.mu)
 
 
 def _one_contact_or_refuse(G: np.ndarray, q: np.ndarray, mu: np.ndarray) -> np.ndarray:
@@ -494,7 +508,7 @@ def _nsgs(
             refined_error = fc3d_error(W, q, mu, refined)
             if refined_error <= error:
                 P, error, polished = refined, refined_error, True
-    if error > tol:
+    if not error <= tol:  # an error that is not finite is above every tolerance
         raise SolverFailure(
             f"Gauss-Seidel stationary after {result.sweeps} sweeps at FC3D error {error:.3g}, "
             f"above the tolerance {tol:g}{_rank_note(W)}"
