@@ -18,6 +18,7 @@ from __future__ import annotations
 import errno
 import os
 import stat
+import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -119,6 +120,24 @@ def output_folder(path: str | Path, what: str = "output folder") -> Path:
             where = "" if ancestor == path else f"{ancestor} is "
             raise InvalidProblem(f"{what} {path}: {where}{kind}, not a directory")
         return path
+    return path
+
+
+def writable_folder(path: str | Path, what: str = "output folder") -> Path:
+    """``path`` as `output_folder` accepts it, made, once a file could be created in it.
+
+    Raises
+    ------
+    InvalidProblem, SolverFailure
+        As `output_folder`, and as `write_error` for a folder that cannot be made or written.
+    """
+    path = output_folder(path, what)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise write_error(exc, what, path) from None
     return path
 
 
