@@ -139,7 +139,8 @@ def _hostile_fclib(path: Path, field: str, value: float, seed: int, form: str) -
             vectors["mu"][...] = abs(value)
         elif field == "shape":
             for key in ("m", "n"):
-                matrix[key][...] = size
+                del matrix[key]
+                matrix.create_dataset(key, data=np.array([size], dtype=np.int64))
         elif field == "text":
             del matrix["x"]
             matrix.create_dataset("x", data=np.array([b"x"] * 3))
