@@ -139,17 +139,12 @@ def test_a_huge_friction_coefficient_leaves_no_contact_approaching(tmp_path, cap
         assert np.allclose(answer["r"], -Q) and np.allclose(answer["u"], 0.0, atol=1e-12)
 
 
-def test_the_fc3d_error_is_unit_free_and_never_nan():
-    W, mu, r = np.eye(3), np.array([0.3]), np.array([1.0, 0.0, 0.0])
-    q = np.array([-1.0, 0.0, 0.0])
-    assert fc3d_error(W, q, mu, r) == 0.0
-    wrong = np.array([0.5, 0.0, 0.0])
-    base = fc3d_error(W, q, mu, wrong)
-    assert base > 0
-    # Units of impulse (W / s, r * s) and of velocity (W * s, q * s) change nothing.
-    for s in (1e-300, 1e300):
-        assert fc3d_error(W / s, q, mu, wrong * s) == pytest.approx(base, rel=1e-12)
-    assert fc3d_error(W * 1e-300, q * 1e-300, mu, wrong) == pytest.approx(base, rel=1e-12)
+def test_the_fc3d_error_never_overflows_and_is_never_nan():
+    W, mu, q = np.eye(3), np.array([0.3]), np.array([-1.0, 0.0, 0.0])
+    assert fc3d_error(W, q, mu, np.array([1.0, 0.0, 0.0])) == 0.0
+    assert fc3d_error(W, q, mu, np.array([0.5, 0.0, 0.0])) > 0
+    # Impulses of 1e300 against a W of 1e-300: a solution, measured without overflow.
+    assert fc3d_error(W * 1e-300, q, mu, np.array([1e300, 0.0, 0.0])) <= 1e-15
     assert fc3d_error(W, q, mu, np.array([math.inf, 0.0, 0.0])) == math.inf
     assert fc3d_error(W, q, mu, np.array([math.nan, 0.0, 0.0])) == math.inf
 

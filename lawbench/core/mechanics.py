@@ -100,27 +100,23 @@ def fc3d_error(W: np.ndarray, q: np.ndarray, mu: np.ndarray, r: np.ndarray) -> f
 
     ``W``, ``q`` and ``r`` in FCLIB's local order (per contact: normal, then its tangents);
     ``u = W r + q``. The natural map of De Saxce's complementarity, per contact
-    ``z_j - P_K(z_j - (u_j + (mu_j |u_Tj|, 0...)))`` with ``z = w r``, in 2-norm over every
-    contact, relative to ``w |r| + |q|``; ``w`` is the largest ``|W_ij|``. Siconos'
-    ``fc3d_compute_error`` takes ``z = r`` and divides by ``|q|``; weighing the impulses by
-    ``W`` makes the measure the same in any unit of impulse and of velocity (a ``W`` of 1e-300
-    with impulses of 1e300 is measured like one of 1 with impulses of 1), and every norm is
-    taken in units of velocity, where impulses of 1e300 overflow none. Zero exactly at a
-    solution; ``inf`` when ``r``, ``u`` or the modified velocity holds a number that is not
-    finite: no tolerance accepts such an answer.
+    ``r_j - P_K(r_j - (u_j + (mu_j |u_Tj|, 0...)))``, in 2-norm over every contact, relative to
+    the largest of ``|q|``, ``|r|`` and ``|u|`` (Siconos' ``fc3d_compute_error``). Every norm
+    is taken with its entries scaled by the largest first, so that impulses of 1e300 (against
+    a ``W`` of 1e-300) overflow none. Zero exactly at a solution; ``inf`` when ``r``, ``u`` or
+    the modified velocity holds a number that is not finite: no tolerance accepts that answer.
     """
-    weight = float(abs(W).max()) if W.size else 0.0
     with np.errstate(over="ignore", invalid="ignore"):
         u = W @ r + q
         dim = r.size // len(mu)
-        z = (weight * r).reshape(-1, dim)
-        uhat = u.reshape(-1, dim).copy()
-        uhat[:, 0] += mu * _norms(uhat[:, 1:])
-    if not (np.isfinite(z).all() and np.isfinite(uhat).all()):
+        rj = r.reshape(-1, dim)
+        x = rj - u.reshape(-1, dim)
+        x[:, 0] -= mu * _norms(u.reshape(-1, dim)[:, 1:])
+    if not (np.isfinite(x).all() and np.isfinite(rj).all()):
         return math.inf
-    residual = _norm((z - project_all(z - uhat, mu)).ravel())
-    scale = _norm(z.ravel()) + _norm(np.asarray(q, dtype=float))
-    return residual / scale if scale > np.finfo(float).tiny else residual
+    error = _norm((rj - project_all(x, mu)).ravel())
+    scale = max(_norm(np.asarray(q, dtype=float)), _norm(r), _norm(u))
+    return error / scale if scale > np.finfo(float).eps else error
 
 
 def _norm(x: np.ndarray) -> float:
