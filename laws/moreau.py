@@ -323,7 +323,8 @@ class Moreau(Law):
             "fixed_point": lambda: _contact_fixed_point(problem, options),
         }
         methods = _methods(options, problem.m, in_contact_space=True)
-        return _in_turn(solvers, methods, options, problem.m)
+        r, diagnostics = _in_turn(solvers, methods, options, problem.m)
+        return _leaving(problem, r, options["tol"]), diagnostics
 
     def _resolve_batch(
         self, batch: ProblemBatch, options: dict[str, Any]
@@ -461,6 +462,19 @@ def _approaching(u: np.ndarray, m: int, tol: float, scale: float) -> bool:
     while the contact goes on approaching.
     """
     return bool(u[:m].min() < -(tol**0.5) * scale)
+
+
+def _leaving(problem: ContactProblem, r: np.ndarray, tol: float) -> np.ndarray:
+    """``r`` when no contact approaches after it (`_approaching`), else the exact state.
+
+    The FC3D error cannot see an approaching contact whose ``un`` the modified velocity lost
+    to rounding (``mu`` near 1e300), nor one of an answer grown far beyond ``q`` on a ``W``
+    that is not positive definite: the normal law is checked on ``u`` itself.
+    """
+    normal = problem.velocity(r)[:: problem.dim]
+    if not _approaching(normal, problem.m, tol, float(np.abs(problem.q).max())):
+        return r
+    return _one_contact_or_refuse(problem.W.toarray(), problem.q, problem.mu)
 
 
 def _one_contact_or_refuse(G: np.ndarray, q: np.ndarray, mu: np.ndarray) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -100,14 +101,32 @@ def fc3d_error(W: np.ndarray, q: np.ndarray, mu: np.ndarray, r: np.ndarray) -> f
     ``W``, ``q`` and ``r`` in FCLIB's local order (per contact: normal, then its tangents);
     ``u = W r + q``. The natural map of De Saxce's complementarity, per contact
     ``r_j - P_K(r_j - (u_j + (mu_j |u_Tj|, 0...)))``, in 2-norm over every contact, relative to
-    the largest of ``|q|``, ``|r|`` and ``|u|`` (Siconos' ``fc3d_compute_error``). Zero exactly
-    at a solution.
+    the largest of ``|q|``, ``|r|`` and ``|u|`` (Siconos' ``fc3d_compute_error``). Every norm
+    is taken with its entries scaled by the largest first, so that impulses of 1e300 (against
+    a ``W`` of 1e-300) overflow none. Zero exactly at a solution; ``inf`` when ``r``, ``u`` or
+    the modified velocity holds a number that is not finite: no tolerance accepts that answer.
     """
-    dim = r.size // len(mu)
-    u = (W @ r + q).reshape(-1, dim)
-    rj = r.reshape(-1, dim)
-    x = rj - u
-    x[:, 0] -= mu * np.linalg.norm(u[:, 1:], axis=1)
-    error = float(np.linalg.norm(rj - project_all(x, mu)))
-    scale = max(float(np.linalg.norm(q)), float(np.linalg.norm(r)), float(np.linalg.norm(u)))
+    with np.errstate(over="ignore", invalid="ignore"):
+        u = W @ r + q
+        dim = r.size // len(mu)
+        rj = r.reshape(-1, dim)
+        x = rj - u.reshape(-1, dim)
+        x[:, 0] -= mu * _norms(u.reshape(-1, dim)[:, 1:])
+    if not (np.isfinite(x).all() and np.isfinite(rj).all()):
+        return math.inf
+    error = _norm((rj - project_all(x, mu)).ravel())
+    scale = max(_norm(np.asarray(q, dtype=float)), _norm(r), _norm(u))
     return error / scale if scale > np.finfo(float).eps else error
+
+
+def _norm(x: np.ndarray) -> float:
+    """The 2-norm of ``x``, its entries scaled by the largest first: squares never overflow."""
+    largest = float(np.abs(x).max(initial=0.0))
+    return largest * float(np.linalg.norm(x / largest)) if largest > 0 else 0.0
+
+
+def _norms(x: np.ndarray) -> np.ndarray:
+    """The 2-norm of each row of ``x``, overflow-free like `_norm`."""
+    largest = np.abs(x).max(axis=1, initial=0.0)
+    safe = np.where(largest > 0, largest, 1.0)
+    return largest * np.linalg.norm(x / safe[:, None], axis=1)

@@ -48,7 +48,7 @@ from lawbench.core.metric import as_array
 from lawbench.core.problem import ImpactProblem
 from lawbench.files.facts import LAYOUTS, ContactSpace, FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py
-from lawbench.files.paths import input_file, output_file
+from lawbench.files.paths import MAX_BYTES, input_file, output_file, replaced
 
 FORMS = ("local", "global")
 # The largest matrix of a global form held dense (entries, 8 MB of doubles); larger ones are
@@ -61,6 +61,9 @@ MASS_SYMMETRY = 1e-12
 SUFFIXES = (".h5", ".hdf5")
 # FCLIB's forms that are not frictional impacts, by their HDF5 group: recognised, and refused.
 OTHER_FORMS = {"fclib_global_rolling": "the global problem with rolling friction"}
+# The most entries one dataset may hold to be read: the doubles of the largest file read,
+# uncompressed. A compressed or never written dataset can claim far more than its file holds.
+MAX_ENTRIES = MAX_BYTES // 8
 
 
 def fclib_form(path: str | Path) -> str | None:
@@ -80,26 +83,25 @@ def form_of(handle: Any) -> str | None:
     return None
 
 
-def _read_matrix(group: Any, where: str) -> tuple[scipy.sparse.csr_matrix, str]:
+def _read_matrix(
+    group: Any, where: str, shape: tuple[int, int], why: str
+) -> tuple[scipy.sparse.csr_matrix, str]:
     """A sparse matrix in any of FCLIB's layouts, and that layout (one of `LAYOUTS`).
 
-    Index arrays are checked against the matrix's shape before scipy sees them.
+    The shape the matrix claims must be ``shape``, which the problem's vectors fix (``why``
+    says how), before anything of its size is allocated: a file may claim a billion rows it
+    holds no entry of. Index arrays are checked against the shape before scipy sees them.
 
     Triplets (``nz >= 0``) hold the row of entry k in ``i[k]`` and its column in ``p[k]``:
     CSparse's triplets, which Siconos and LMGC90 write (the field comments of ``fclib.h`` name
     them the other way round; in the files of theirs read here ``i`` stays within the rows and
     ``p`` within the columns). Repeated entries are summed.
     """
-
-    def number(key: str) -> int:
-        if key not in group:
-            raise InvalidProblem(f"{where}/{key} is missing")
-        return int(np.asarray(group[key][()]).ravel()[0])
-
-    m, n, nz = number("m"), number("n"), number("nz")
-    if m < 0 or n < 0:
-        raise InvalidProblem(f"{where}: a matrix of {m} x {n}")
-    p, i, x = (_array(group, key, where) for key in ("p", "i", "x"))
+    group = _group(group, where)
+    m, n, nz = (_number(group, key, where) for key in ("m", "n", "nz"))
+    if (m, n) != shape:
+        raise InvalidProblem(f"{where} is {m} x {n} where {why} need {shape[0]} x {shape[1]}")
+    p, i, x = (_dataset(group, key, where) for key in ("p", "i", "x"))
     for key, index in (("p", p), ("i", i)):
         if not np.issubdtype(index.dtype, np.integer):
             raise InvalidProblem(f"{where}/{key} holds {index.dtype}, not integers")
@@ -134,10 +136,46 @@ def _read_matrix(group: Any, where: str) -> tuple[scipy.sparse.csr_matrix, str]:
     return scipy.sparse.csr_matrix(matrix(arrays, shape=(m, n))), LAYOUTS[-nz]
 
 
-def _array(group: Any, key: str, where: str) -> np.ndarray:
+def _group(node: Any, where: str) -> Any:
+    """``node`` once it is known to be an HDF5 group (``where`` names it)."""
+    if not isinstance(node, require_h5py().Group):
+        raise InvalidProblem(f"{where} is a dataset, not a group")
+    return node
+
+
+def _dataset(group: Any, key: str, where: str) -> np.ndarray:
+    """The numbers of dataset ``group[key]``, flat, read once known to be a bounded dataset.
+
+    Raises
+    ------
+    InvalidProblem
+        Naming ``where/key``: missing, a group, more than `MAX_ENTRIES` entries, or entries
+        that are not real numbers (text, compound records, an empty dataspace).
+    """
     if key not in group:
-        raise InvalidProblem(f"{where}/{key} is missing (p, i and x are needed)")
-    return np.asarray(group[key][()]).ravel()
+        raise InvalidProblem(f"{where}/{key} is missing")
+    node = group[key]
+    if not isinstance(node, require_h5py().Dataset):
+        raise InvalidProblem(f"{where}/{key} is a group, not a dataset")
+    if (node.size or 0) > MAX_ENTRIES:
+        raise InvalidProblem(
+            f"{where}/{key} claims {node.size} entries, more than the {MAX_ENTRIES} read at most"
+        )
+    data = np.asarray(node[()]).ravel()
+    if data.dtype.kind not in "iuf":
+        raise InvalidProblem(f"{where}/{key} holds {data.dtype}, not numbers")
+    return data
+
+
+def _number(group: Any, key: str, where: str) -> int:
+    """The one integer dataset ``group[key]`` holds (a size, a count, a dimension)."""
+    data = _dataset(group, key, where)
+    if data.size != 1:
+        raise InvalidProblem(f"{where}/{key} holds {data.size} entries, not one integer")
+    value = data[0]
+    if data.dtype.kind == "f" and not (np.isfinite(value) and value == int(value)):
+        raise InvalidProblem(f"{where}/{key} = {value!r}: not an integer")
+    return int(value)
 
 
 def _within(index: np.ndarray, bound: int, where: str) -> None:
@@ -167,18 +205,21 @@ def _write_matrix(group: Any, matrix: np.ndarray) -> None:
     group.create_dataset("x", data=coo.data.astype(float))
 
 
-def _vector(group: Any, key: str, where: str) -> np.ndarray:
-    if key not in group:
-        raise InvalidProblem(f"{where}/{key} is missing")
-    return np.asarray(group[key][()], dtype=float).ravel()
-
-
-def _split(W: Any, dim: int, mu: np.ndarray, where: str) -> dict[str, Any]:
-    """Normal and tangential columns from FCLIB's per-contact (n, t1[, t2]) order."""
-    if W.shape[1] % dim or W.shape[1] // dim != mu.size:
+def _vector(group: Any, key: str, where: str, size: int | None = None) -> np.ndarray:
+    """The dataset ``group[key]`` as floats; of ``size`` entries when given."""
+    data = _dataset(group, key, where).astype(float)
+    if size is not None and data.size != size:
         raise InvalidProblem(
-            f"{where}: {W.shape[1]} local coordinates for {mu.size} contacts of dimension {dim}"
+            f"{where}/{key} holds {data.size} entries; the problem's other fields need {size}"
         )
+    return data
+
+
+def _split(W: Any, dim: int, mu: np.ndarray) -> dict[str, Any]:
+    """Normal and tangential columns from FCLIB's per-contact (n, t1[, t2]) order.
+
+    ``W`` has ``dim`` columns per entry of ``mu``, as `read_open` checked.
+    """
     first = np.arange(mu.size)[:, None] * dim
     return {"Wn": W[:, first[:, 0]], "Wt": W[:, (first + np.arange(1, dim)).ravel()]}
 
@@ -261,7 +302,7 @@ class FclibRead:
             return ProblemFile(ContactProblem(space.W, space.q, mu, dim, name=name), facts)
         try:
             problem = ImpactProblem.from_arrays(
-                M, v=_solve(M, f, where), **_split(H, dim, mu, where), e=0.0, mu=mu
+                M, v=_solve(M, f, where), **_split(H, dim, mu), e=0.0, mu=mu
             )
         except InvalidProblem as exc:
             raise InvalidProblem(f"{where}: {exc}") from None
@@ -278,20 +319,26 @@ def read_open(handle: Any, where: str) -> FclibRead:
     """
     try:
         root, form, where, dim = _root(handle, where)
-        vectors = root["vectors"]
-        mu = _vector(vectors, "mu", f"{where}/vectors")
+        at = f"{where}/vectors"
+        vectors = _group(root["vectors"], at)
+        mu = _vector(vectors, "mu", at)
+        size = mu.size * dim  # the contacts' local coordinates
+        local = f"{mu.size} contacts of dimension {dim}"
         if form == "local":
             if "V" in root or "R" in root:
                 raise InvalidProblem(f"{where}/V, R: mixed problems are not an impact problem")
-            W, layout = _read_matrix(root["W"], f"{where}/W")
-            arrays = {"W": W, "q": _vector(vectors, "q", f"{where}/vectors")}
-            _check_local(W, arrays["q"], mu.size * dim, where)
-            return FclibRead(form, where, dim, mu, arrays, (("W", layout),))
+            q = _vector(vectors, "q", at, size)
+            W, layout = _read_matrix(_member(root, "W", where), f"{where}/W", (size, size), local)
+            return FclibRead(form, where, dim, mu, {"W": W, "q": q}, (("W", layout),))
         if "G" in root:
             raise InvalidProblem(f"{where}/G: equality constraints are not an impact problem")
-        (M, of_M), (H, of_H) = (_read_matrix(root[k], f"{where}/{k}") for k in ("M", "H"))
-        arrays = {"M": _held(M), "H": _held(H)}
-        arrays |= {key: _vector(vectors, key, f"{where}/vectors") for key in ("f", "w")}
+        f = _vector(vectors, "f", at)
+        n, coordinates = f.size, f"the {f.size} entries of f"
+        M, of_M = _read_matrix(_member(root, "M", where), f"{where}/M", (n, n), coordinates)
+        H, of_H = _read_matrix(
+            _member(root, "H", where), f"{where}/H", (n, size), f"{coordinates} and {local}"
+        )
+        arrays = {"M": _held(M), "H": _held(H), "f": f, "w": _vector(vectors, "w", at, size)}
         return FclibRead(form, where, dim, mu, arrays, (("M", of_M), ("H", of_H)))
     except LawbenchError:
         raise
@@ -314,14 +361,20 @@ def _root(handle: Any, where: str) -> tuple[Any, str, str, int]:
                     "Coulomb friction only (no rolling resistance)"
                 )
         raise InvalidProblem(f"{where}: neither /fclib_local nor /fclib_global")
-    root = handle[f"fclib_{form}"]
     where = f"{where}:/fclib_{form}"
-    dim = int(np.asarray(root["spacedim"][()]).ravel()[0]) if "spacedim" in root else 3
+    root = _group(handle[f"fclib_{form}"], where)
+    dim = _number(root, "spacedim", where) if "spacedim" in root else 3
     if dim not in (2, 3):
         raise InvalidProblem(f"{where}/spacedim = {dim}: must be 2 or 3")
-    if "vectors" not in root:
-        raise InvalidProblem(f"{where}/vectors is missing")
+    _member(root, "vectors", where)
     return root, form, where, dim
+
+
+def _member(group: Any, key: str, where: str) -> Any:
+    """``group[key]``, or an `InvalidProblem` naming it when it is missing."""
+    if key not in group:
+        raise InvalidProblem(f"{where}/{key} is missing")
+    return group[key]
 
 
 def _no_impact(M: Any, w: np.ndarray) -> str:
@@ -332,15 +385,6 @@ def _no_impact(M: Any, w: np.ndarray) -> str:
     if np.any(w):
         return "w, a constant local velocity, has no impact counterpart"
     return ""
-
-
-def _check_local(W: Any, q: np.ndarray, size: int, where: str) -> None:
-    """Refuse a local form whose ``W`` is not ``size`` square or whose ``q`` is not as long."""
-    if W.shape != (size, size) or q.size != size:
-        raise InvalidProblem(
-            f"{where}: W is {W.shape[0]} x {W.shape[1]} and q holds {q.size} entries; "
-            f"{size} contact coordinates (spacedim times the entries of mu) need {size} x {size}"
-        )
 
 
 def _solve(M: Any, rhs: np.ndarray, where: str) -> np.ndarray:
@@ -374,7 +418,9 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
     ------
     InvalidProblem
         For an unknown form, a path whose extension is not an HDF5 one, or a file that cannot
-        be written.
+        be written (`lawbench.files.paths.replaced`: the file is written whole or not at all).
+    SolverFailure
+        For a disk that runs out of room; the file is left as it was.
     """
     if form not in FORMS:
         raise InvalidProblem(f"FCLIB form {form!r}: must be one of {', '.join(FORMS)}")
@@ -402,11 +448,7 @@ def write_fclib(problem: ImpactProblem, path: str | Path, form: str = "local") -
         dim = 2
     else:
         W, dim = problem.W[:, _local_order(problem)], problem.d + 1
-    try:
-        handle = require_h5py().File(path, "w")
-    except OSError as exc:
-        raise InvalidProblem(f"{path}: cannot be written ({exc})") from None
-    with handle:
+    with replaced(path, "FCLIB file") as temporary, require_h5py().File(temporary, "w") as handle:
         root = handle.create_group(f"fclib_{form}")
         root.create_dataset("spacedim", data=np.array([dim], dtype=np.int32))
         vectors = root.create_group("vectors")

@@ -5,15 +5,25 @@ to it (for ever, from a shell), a device or ``/dev/zero`` never ends, and a dire
 problem. An output must be a regular file or not exist yet: writing into a FIFO blocks, and
 writing over a device or a directory is never what was meant. Both are decided from the path's
 status, which never blocks, before anything is opened.
+
+Every file is written whole or not at all (`replaced`): into a temporary file beside it, created
+before the work so that a folder that cannot be written is known at once, then moved over the
+path with `os.replace`. A symbolic link is written through: the file it names is replaced, the
+link kept. A full disk is a `SolverFailure` (the work failed for want of room), a path that
+cannot be written an `InvalidProblem`; either names the path, and no file is left half written.
 """
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
-from lawbench.core.errors import InvalidProblem
+from lawbench.core.errors import InvalidProblem, LawbenchError, SolverFailure
 
 # The largest input file read (bytes): the largest FCLIB problems of the field are a few MB.
 MAX_BYTES = 1 << 30
@@ -111,3 +121,69 @@ def output_folder(path: str | Path, what: str = "output folder") -> Path:
             raise InvalidProblem(f"{what} {path}: {where}{kind}, not a directory")
         return path
     return path
+
+
+def writable_folder(path: str | Path, what: str = "output folder") -> Path:
+    """``path`` as `output_folder` accepts it, made, once a file could be created in it.
+
+    Raises
+    ------
+    InvalidProblem, SolverFailure
+        As `output_folder`, and as `write_error` for a folder that cannot be made or written.
+    """
+    path = output_folder(path, what)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise write_error(exc, what, path) from None
+    return path
+
+
+# The errors of a write that ran out of room rather than of permission.
+NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
+def write_error(exc: OSError, what: str, path: str | Path) -> LawbenchError:
+    """The error to raise for ``exc``, met writing ``what`` at ``path``, in one line.
+
+    Out of room (`NO_ROOM`: a full disk, a quota, a file too large) is a `SolverFailure`; any
+    other (a read-only file system, a permission, a path that is no folder) an `InvalidProblem`.
+    """
+    reason = exc.strerror or str(exc)
+    if exc.errno in NO_ROOM:
+        return SolverFailure(f"{what} {path}: cannot be written ({reason}); nothing was replaced")
+    return InvalidProblem(f"{what} {path}: cannot be written ({reason})")
+
+
+@contextmanager
+def replaced(path: str | Path, what: str = "output") -> Iterator[Path]:
+    """A temporary file beside ``path`` to write, moved over ``path`` when the block ends.
+
+    The temporary file is created on entry, before any work of the block. A symbolic link
+    ``path`` is written through (the file it names is replaced). When the block raises, the
+    temporary file is removed and ``path`` is left as it was.
+
+    Raises
+    ------
+    InvalidProblem, SolverFailure
+        As `write_error`, for an ``OSError`` of the folder, of the block's writes or of the
+        move; ``InvalidProblem`` as `output_file` for a ``path`` that is not a regular file.
+    """
+    target = Path(os.path.realpath(output_file(path, what)))
+    temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+    try:
+        temporary.parent.mkdir(parents=True, exist_ok=True)
+        os.close(os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+    except OSError as exc:
+        raise write_error(exc, what, path) from None
+    try:
+        yield temporary
+        os.replace(temporary, target)
+    except OSError as exc:
+        temporary.unlink(missing_ok=True)
+        raise write_error(exc, what, path) from None
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise

@@ -46,7 +46,7 @@ from lawbench.core.metric import is_sparse
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.files.facts import FileFacts, ProblemFile
 from lawbench.files.hdf5 import require_h5py
-from lawbench.files.paths import MAX_BYTES, input_file, output_file
+from lawbench.files.paths import MAX_BYTES, input_file, output_file, replaced
 
 if TYPE_CHECKING:
     from lawbench.files.fclib import FclibRead
@@ -132,16 +132,20 @@ def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
     Raises
     ------
     InvalidProblem
-        For an unknown extension, or a file that cannot be written.
+        For an unknown extension, or a file that cannot be written (it is written whole or not
+        at all: `lawbench.files.paths.replaced`).
+    SolverFailure
+        For a disk that runs out of room; the file is left as it was.
     """
     if not isinstance(problem, ImpactProblem):
         raise TypeError(f"problem must be an ImpactProblem, not {type(problem).__name__}")
     path = output_file(path, "problem file")
     writer = _codec(path)[0]
-    try:
-        writer(to_dict(problem), path)
-    except OSError as exc:
-        raise InvalidProblem(f"{path}: cannot be written ({exc.strerror or exc})") from None
+    data = to_dict(problem)
+    if writer is _write_json:
+        _fits_json(data, path)
+    with replaced(path, "problem file") as temporary:
+        writer(data, temporary)
     return path
 
 
@@ -223,15 +227,21 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"cannot write {type(value).__name__}")
 
 
-def _write_json(data: dict[str, Any], path: Path) -> None:
-    # JSON holds matrices dense, each entry at least two characters ("0,"): a file that no
-    # reader takes (more than MAX_BYTES) is refused before its dense copy is made.
+def _fits_json(data: dict[str, Any], path: Path) -> None:
+    """Refuse a problem whose JSON file no reader would take, before its dense copy is made.
+
+    JSON holds matrices dense, each entry at least two characters (``0,``): more than
+    `MAX_BYTES` is more than a problem file may hold.
+    """
     entries = sum(int(np.prod(value.shape)) for value in data.values() if is_sparse(value))
     if 2 * entries > MAX_BYTES:
         raise InvalidProblem(
             f"{path}: JSON holds matrices dense, {entries:.3g} entries here, more than a problem "
             f"file may hold ({MAX_BYTES} bytes); write .npz or .h5, which keep them sparse"
         )
+
+
+def _write_json(data: dict[str, Any], path: Path) -> None:
     path.write_text(json.dumps(data, default=_json_default, indent=1, allow_nan=False) + "\n")
 
 

@@ -486,7 +486,7 @@ def solve_polished(
     m = len(mu)
     result = solve_nsgs(W, q, mu, dim, tol)
     P, error, polished = result.P, result.error, False
-    if error > tol and polish:
+    if not error <= tol and polish:  # a NaN error is no answer either
         back = np.argsort(local_order(m, dim - 1))
         G, lawbench_q = scipy.sparse.csr_matrix(W)[back][:, back].toarray(), q[back]
         refined = cones.polish(G, lawbench_q, mu, dim - 1, P[back], True)
@@ -495,7 +495,7 @@ def solve_polished(
             refined_error = fc3d_error(W, q, mu, refined)
             if refined_error <= error:
                 P, error, polished = refined, refined_error, True
-    if error > tol:
+    if not error <= tol:
         raise SolverFailure(
             f"Gauss-Seidel stationary after {result.sweeps} sweeps at FC3D error {error:.3g}, "
             f"above the tolerance {tol:g}{_rank_note(W)}"

@@ -106,11 +106,17 @@ class RunSpec:
             if name not in CHECKS:
                 raise InvalidProblem(f"spec: unknown check {name!r}; known: {', '.join(CHECKS)}")
         sizes = _typed(data.get("continuity_sizes", [1e-2, 1e-4, 1e-6]), list, "continuity_sizes")
-        if not all(isinstance(x, int | float) and not isinstance(x, bool) for x in sizes):
-            raise InvalidProblem(f"spec: key 'continuity_sizes' holds numbers, got {sizes!r}")
+        # Relative perturbations of the gaps and velocities: positive and finite, or no probe.
+        if not all(
+            isinstance(x, int | float) and not isinstance(x, bool) and 0 < x < math.inf
+            for x in sizes
+        ):
+            raise InvalidProblem(
+                f"spec: key 'continuity_sizes' holds positive finite numbers, got {sizes!r}"
+            )
         seed = data.get("seed", 0)
-        if not isinstance(seed, int) or isinstance(seed, bool):
-            raise InvalidProblem(f"spec: key 'seed' must be an integer, got {seed!r}")
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise InvalidProblem(f"spec: key 'seed' must be an integer >= 0, got {seed!r}")
         return cls(grids, seed, checks, tuple(float(x) for x in sizes))
 
     def rows(self) -> list[Job]:
@@ -473,8 +479,8 @@ class Generated(Sequence[Any]):
             raise InvalidProblem(f"spec {_key(where)}: unknown value generator {dict(spec)}")
         try:
             start, stop, count = spec[self.kind]
-            self.start, self.stop, self.count = float(start), float(stop), int(count)
-            self.width = int(spec.get("size", 1))
+            self.start, self.stop = float(start), float(stop)
+            self.count, self.width = _whole(count, "count"), _whole(spec.get("size", 1), "size")
         except (TypeError, ValueError, OverflowError) as exc:
             raise InvalidProblem(
                 f"spec {_key(where)}: bad value generator {dict(spec)} ({exc})"
@@ -545,6 +551,13 @@ class Generated(Sequence[Any]):
         else:
             draws = rng.uniform(self.start, self.stop, (count, self.width))
         return [row[0] if self.width == 1 else row for row in draws.tolist()]
+
+
+def _whole(value: Any, what: str) -> int:
+    """``value`` as an int, or a ValueError for a number with a fraction (a count of 2.5)."""
+    if isinstance(value, bool) or int(value) != value:
+        raise ValueError(f"the {what} {value!r} is not a whole number")
+    return int(value)
 
 
 def _position(index: int, length: int) -> int:

@@ -47,7 +47,7 @@ from filelock import FileLock, Timeout
 
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.verdicts import Verdict
-from lawbench.files.paths import input_file, output_file
+from lawbench.files.paths import input_file, output_file, replaced, write_error
 
 log = logging.getLogger("lawbench.studies.runner")
 # The grid an unfinished output belongs to, beside its chunks.
@@ -175,19 +175,20 @@ def write_table(table: pd.DataFrame, path: Path, meta: Mapping[str, Any]) -> Non
     """
     path = Path(path)
     kind = file_format(path)
-    temporary = path.with_name(f".{path.name}.tmp")
     if kind == "csv":
         _atomic_text(_sidecar(path), json.dumps(meta, indent=1))
-        _expanded(table, _wide(meta)).to_csv(temporary, index=False)
-    else:
-        arrow = pa.Table.from_pandas(table, preserve_index=False)
-        given = dict(arrow.schema.metadata or {})
-        arrow = arrow.replace_schema_metadata({**given, META_KEY: json.dumps(meta).encode()})
+        with replaced(path, "run table") as temporary:
+            _expanded(table, _wide(meta)).to_csv(temporary, index=False)
+        return
+    arrow = pa.Table.from_pandas(table, preserve_index=False)
+    given = dict(arrow.schema.metadata or {})
+    arrow = arrow.replace_schema_metadata({**given, META_KEY: json.dumps(meta).encode()})
+    # Written to an open file: Arrow takes a path as UTF-8, which a file name need not be.
+    with replaced(path, "run table") as temporary, temporary.open("wb") as handle:
         if kind == "parquet":
-            pq.write_table(arrow, temporary)
+            pq.write_table(arrow, handle)
         else:
-            feather.write_feather(arrow, temporary)
-    os.replace(temporary, path)
+            feather.write_feather(arrow, handle)
 
 
 def save_run(records: pd.DataFrame, path: Path, meta: Mapping[str, Any]) -> Path:
@@ -214,11 +215,7 @@ def save_run(records: pd.DataFrame, path: Path, meta: Mapping[str, Any]) -> Path
     path = output_file(path, "run table")
     file_format(path)
     tidied, layout = tidy(records)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_table(tidied, path, {**meta, **layout})
-    except OSError as exc:
-        raise InvalidProblem(f"--out {path}: cannot write ({exc.strerror})") from None
+    write_table(tidied, path, {**meta, **layout})
     return path
 
 
@@ -232,9 +229,9 @@ def _sidecar(path: Path) -> Path:
 
 
 def _atomic_text(path: Path, text: str) -> None:
-    temporary = path.with_name(f".{path.name}.tmp")
-    temporary.write_text(text)
-    os.replace(temporary, path)
+    # A command line may hold a file name that is not UTF-8: escaped, never refused.
+    with replaced(path, "run file") as temporary:
+        temporary.write_text(text, encoding="utf-8", errors="backslashreplace")
 
 
 def _expanded(table: pd.DataFrame, vectors: Sequence[str]) -> pd.DataFrame:
@@ -304,7 +301,8 @@ def _read(path: Path, kind: str, meta: dict[str, Any]) -> tuple[pd.DataFrame, di
         for name in _verdict_columns(table):
             table[name] = pd.Categorical(table[name], categories=VERDICTS)
         return table, meta
-    arrow = pq.read_table(path) if kind == "parquet" else feather.read_table(path)
+    with path.open("rb") as handle:
+        arrow = pq.read_table(handle) if kind == "parquet" else feather.read_table(handle)
     meta = json.loads((arrow.schema.metadata or {}).get(META_KEY, b"{}"))
     return arrow.to_pandas(), meta
 
@@ -356,6 +354,11 @@ def load_run(path: str | os.PathLike[str]) -> pd.DataFrame:
     return table
 
 
+def fingerprint(name: str, keys: Sequence[str]) -> str:
+    """The identity of a grid: a digest of its plan's name and its cells' sorted keys."""
+    return hashlib.sha256("\n".join([name, *sorted(keys)]).encode()).hexdigest()
+
+
 def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
@@ -376,20 +379,19 @@ class Store:
     @contextmanager
     def locked(self, wait: bool = False) -> Iterator[None]:
         """Hold the output's lock; without ``wait``, a held lock raises `InvalidProblem`."""
-        try:
-            self.out.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise InvalidProblem(f"--out {self.out}: cannot be written ({exc.strerror})") from None
-        if not os.access(self.out.parent, os.W_OK):
-            raise InvalidProblem(f"--out {self.out}: its folder cannot be written")
         lock = FileLock(self.lock_path, timeout=-1 if wait else 0)
         try:
+            # Creating the lock file is the first write: a folder that cannot be written (read
+            # only, full, under /sys) is known before any cell is computed.
+            self.out.parent.mkdir(parents=True, exist_ok=True)
             lock.acquire()
         except Timeout:
             raise InvalidProblem(
                 f"--out {self.out} is locked by another run ({self._owner()}; lock file "
                 f"{self.lock_path}): wait for it with --wait, or choose another --out"
             ) from None
+        except OSError as exc:  # after Timeout, which is one
+            raise write_error(exc, "--out", self.out) from None
         try:
             started = datetime.datetime.now().isoformat(timespec="seconds")
             owner = f"pid {os.getpid()} on {socket.gethostname()} since {started}: "
@@ -418,13 +420,38 @@ class Store:
         if (self.parts / GRID_FILE).exists():
             held = _json(self.parts / GRID_FILE, "run grid")
         elif self.out.exists():
-            held = read_table(self.out)[1]
+            held = self._finished(grid)
         if held.get("grid", grid) != grid:
             raise InvalidProblem(
                 f"--out {self.out} holds the cells of another grid ({held['grid_described']}); "
                 f"this run's grid is {described}: give another --out"
             )
         self._grid = {"grid": grid, "grid_described": described}
+
+    def _finished(self, grid: str) -> dict[str, Any]:
+        """The metadata of the finished table at ``out``, once it is known to be a run's.
+
+        Raises
+        ------
+        InvalidProblem
+            For a table without a run's metadata (a user's own file: resuming would count its
+            rows as cells), or whose rows are not the cells of the grid it names (rows added,
+            removed or edited since the run wrote it).
+        """
+        table, held = read_table(self.out)
+        if "grid" not in held or "key" not in table.columns or "study" not in table.columns:
+            raise InvalidProblem(
+                f"--out {self.out}: a table no run wrote (no run metadata): give another --out"
+            )
+        studies = set(table["study"].fillna(""))
+        name = studies.pop() if len(studies) == 1 else None
+        keys = sorted(str(key) for key in table["key"])
+        if held["grid"] == grid and fingerprint(name or "", keys) != grid:
+            raise InvalidProblem(
+                f"--out {self.out}: its rows are not the cells of the grid it was written for "
+                "(rows were added, removed or edited): give another --out"
+            )
+        return held
 
     def chunks(self) -> list[Path]:
         """The chunk files, in the order they were written."""
@@ -463,7 +490,8 @@ class Store:
         expected = sidecar.read_text().split()[0] if sidecar.exists() else None
         try:
             if expected is not None and _digest(path) == expected:
-                return pd.read_parquet(path)
+                with path.open("rb") as handle:
+                    return pd.read_parquet(handle)
             reason = "no checksum" if expected is None else "checksum mismatch"
         except (OSError, pa.ArrowException) as exc:
             reason = f"unreadable: {exc}"
@@ -474,7 +502,19 @@ class Store:
         return None
 
     def write_chunk(self, records: list[dict]) -> None:
-        """Write one chunk whole: checksum sidecar first, then the chunk moved in place."""
+        """Write one chunk whole: checksum sidecar first, then the chunk moved in place.
+
+        Raises
+        ------
+        InvalidProblem, SolverFailure
+            As `lawbench.files.paths.write_error`: a folder that became read only, a full disk.
+        """
+        try:
+            self._write_chunk(records)
+        except OSError as exc:
+            raise write_error(exc, "--out", self.out) from None
+
+    def _write_chunk(self, records: list[dict]) -> None:
         self.parts.mkdir(parents=True, exist_ok=True)
         if self._grid and not (self.parts / GRID_FILE).exists():
             _atomic_text(self.parts / GRID_FILE, json.dumps(self._grid))
@@ -482,7 +522,8 @@ class Store:
         number = int(written[-1].stem.split("-")[1]) + 1 if written else 0
         path = self.parts / f"part-{number:06d}.parquet"
         temporary = path.with_name(f".{path.name}.tmp")
-        pd.DataFrame(records).to_parquet(temporary, index=False)
+        with temporary.open("wb") as handle:
+            pd.DataFrame(records).to_parquet(handle, index=False)
         _atomic_text(path.with_name(path.name + ".sha256"), f"{_digest(temporary)}  {path.name}\n")
         os.replace(temporary, path)
 

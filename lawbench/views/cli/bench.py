@@ -6,7 +6,7 @@ import argparse
 
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
-from lawbench.files.paths import output_file
+from lawbench.files.paths import output_file, replaced
 from lawbench.views.cli.main import _names, _path, _seconds, _tolerance
 
 # Seconds one law may spend on one file of ``lawbench bench --problems``.
@@ -83,23 +83,22 @@ def _bench_problems(args: argparse.Namespace) -> None:
         raise InvalidProblem(f"bench --out {args.out}: the table is CSV (.csv)")
     laws = _names(args.laws, "--laws", LAWS)
     tol = SOLVED_FC3D if args.tol is None else args.tol
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InvalidProblem(f"bench --out {args.out}: cannot be written ({exc})") from None
-    table, notes = bench_problems(
-        args.problems,
-        args.max_seconds,
-        None if laws == ["*"] else laws,
-        tol,
-        args.peer_tol,
-    )
-    with out.open("w", encoding="utf-8") as handle:
-        handle.writelines(f"# {note}\n" for note in notes)
-        table.to_csv(handle, index=False)
-    from lawbench.views.plotting import plot_profiles
-
     figure = out.with_suffix(".png")
-    plot_profiles(performance_profiles(table, tol)).figure.savefig(figure, dpi=120)
+    # Both files' temporaries are created before the work: a folder that cannot be written is
+    # known before every law has run on every file.
+    with replaced(out, "bench --out") as table_file, replaced(figure, "bench --out") as drawn:
+        table, notes = bench_problems(
+            args.problems,
+            args.max_seconds,
+            None if laws == ["*"] else laws,
+            tol,
+            args.peer_tol,
+        )
+        with table_file.open("w", encoding="utf-8") as handle:
+            handle.writelines(f"# {note}\n" for note in notes)
+            table.to_csv(handle, index=False)
+        from lawbench.views.plotting import plot_profiles
+
+        plot_profiles(performance_profiles(table, tol)).figure.savefig(drawn, dpi=120, format="png")
     print(problems_summary(table, notes, tol))
     print(f"table written to {out}, performance profiles to {figure}")

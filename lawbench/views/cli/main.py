@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import io
 import logging
+import os
 import sys
 import warnings
 from collections.abc import Callable, Sequence
@@ -22,6 +24,7 @@ from lawbench.core.errors import (
 )
 from lawbench.core.guards import watch_interrupts
 from lawbench.core.registry import Registry
+from lawbench.files.paths import NO_ROOM
 from lawbench.studies.guard import BUDGET_S, EXECUTORS
 
 
@@ -222,7 +225,67 @@ def _command(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit code."""
+    """Run the command line; return the exit code.
+
+    The streams are handled as Python's command-line tools handle them: a character the
+    terminal's encoding lacks (or a file name that is not UTF-8) is written escaped; a reader
+    that closed the pipe ends the command quietly, exit 1 (Python's advice on SIGPIPE); an
+    output that cannot be written (``> /dev/full``) is one line and exit 4; a closed stderr
+    is not written to.
+    """
+    _escaping_streams()
+    try:
+        code = _main(argv)
+        if sys.stdout is not None:
+            sys.stdout.flush()  # a full device fails here, not in the interpreter's exit
+    except BrokenPipeError:
+        _silence_stdout()
+        return 1
+    except OSError as exc:  # the standard output itself cannot be written
+        _silence_stdout()
+        return _os_error(exc)
+    return code
+
+
+def _os_error(exc: OSError) -> int:
+    """Say what the system refused, in one line; exit 4 out of room, 2 for anything else."""
+    where = f"{exc.filename}: " if exc.filename is not None else "the output: "
+    _say(f"lawbench: {where}{exc.strerror or exc}")
+    return 4 if exc.errno in NO_ROOM else 2
+
+
+def _escaping_streams() -> None:
+    """Standard output and error write what their encoding lacks as backslash escapes."""
+    for stream in (sys.stdout, sys.stderr):
+        if isinstance(stream, io.TextIOWrapper):
+            stream.reconfigure(errors="backslashreplace")
+
+
+def _silence_stdout() -> None:
+    """Point standard output at /dev/null: the interpreter's last flush must not fail again."""
+    if sys.stdout is None:
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # a stream with no descriptor (a test's capture)
+        pass
+    finally:
+        os.close(devnull)
+
+
+def _say(line: str) -> None:
+    """Write ``line`` on standard error, unless it is closed (``2>&-``) or cannot be written."""
+    if sys.stderr is None:
+        return
+    try:
+        print(line, file=sys.stderr, flush=True)
+    except OSError:
+        pass
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    """`main` without its handling of the standard streams."""
     # The run machinery reports damaged chunks through logging: one line on stderr each.
     logging.basicConfig(format="lawbench: %(message)s", level=logging.WARNING)
     watch_interrupts()
@@ -240,28 +303,28 @@ def main(argv: Sequence[str] | None = None) -> int:
         # What an export leaves out is always said; a library's warnings only when asked for.
         for warning in caught:
             if args.verbose or issubclass(warning.category, LossyExport):
-                print(f"lawbench: warning: {warning.message}", file=sys.stderr)
+                _say(f"lawbench: warning: {warning.message}")
     except LawbenchError as exc:
-        print(f"lawbench: {_one_line(exc)}", file=sys.stderr)
+        _say(f"lawbench: {_one_line(exc)}")
         return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
-    except BrokenPipeError:
-        return 0
     except MemoryError:
         return _out_of_memory()
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError) or exc.filename is None:
+            raise  # the standard streams, which `main` handles
+        return _os_error(exc)
     except KeyboardInterrupt:
-        print(
-            "lawbench: interrupted; finished rows are kept (rerun with --resume)", file=sys.stderr
-        )
+        _say("lawbench: interrupted; finished rows are kept (rerun with --resume)")
         return 130
     except Exception as exc:  # a bug: still one line, never a traceback
-        print(f"lawbench: internal error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
+        _say(f"lawbench: internal error: {type(exc).__name__}: {_one_line(exc)}")
         return 1
     return 0
 
 
 def _out_of_memory() -> int:
     """One line and a solver failure's exit code: the work needed more memory than it got."""
-    print("lawbench: out of memory (MemoryError)", file=sys.stderr)
+    _say("lawbench: out of memory (MemoryError)")
     return EXIT_CODES[SolverFailure]
 
 

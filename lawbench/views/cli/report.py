@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from lawbench.files.paths import output_folder
+from lawbench.files.paths import writable_folder
 from lawbench.views.cli.main import _path
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
@@ -37,5 +37,6 @@ def run(args: argparse.Namespace) -> None:
     """Write the report into ``--out``."""
     from lawbench.views.report import write_report
 
-    path = write_report(output_folder(args.out, "report folder"), mode=args.mode)
+    # Known writable before the studies run, not after.
+    path = write_report(writable_folder(args.out, "report folder"), mode=args.mode)
     print(f"report written to {path}")

@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 import scipy
 
+from lawbench.core.errors import SolverFailure
 from lawbench.core.verdicts import Verdict
 from lawbench.studies.guard import Guard
 from lawbench.views.report import (
@@ -88,7 +89,7 @@ def _save(guard: Guard) -> Any:
             result = guard.result(handle)
             if result.status != "ok":
                 reason = f"{result.error_class or result.status}: {result.error_message}"
-                raise RuntimeError(f"figure {figure.name} could not be written: {reason}")
+                raise SolverFailure(f"figure {figure.name} could not be written: {reason}")
 
     return save
 

@@ -24,6 +24,7 @@ from matplotlib import rc_context
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure as MplFigure
 
+from lawbench.files.paths import replaced
 from lawbench.views.report.marks import COLOURS, GLYPHS, Mark, legend
 
 LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
@@ -232,8 +233,10 @@ def save_figure(figure: MplFigure, name: str, data: pd.DataFrame, out: Path) -> 
     FigureCanvasAgg(figure)
     # A tight bounding box keeps the legends placed outside the axes.
     with rc_context({"svg.hashsalt": "lawbench"}):
-        figure.savefig(out / f"{name}.svg", metadata={"Date": None}, bbox_inches="tight")
-    data.to_csv(out / f"{name}.csv", index=False)
+        with replaced(out / f"{name}.svg", "report figure") as temporary:
+            figure.savefig(temporary, format="svg", metadata={"Date": None}, bbox_inches="tight")
+    with replaced(out / f"{name}.csv", "report table") as temporary:
+        data.to_csv(temporary, index=False)
 
 
 def save_serially(figures: list[Figure], out: Path) -> None:
@@ -279,15 +282,22 @@ def write_page(
     for block in blocks:
         if isinstance(block, Table):
             data = _plain(block.frame) if block.data is None else block.data
-            data.to_csv(out / f"{block.name}.csv", index=False)
-    (out / "index.html").write_text(_Html(rerun).page(title, preamble, sections))
+            with replaced(out / f"{block.name}.csv", "report table") as temporary:
+                data.to_csv(temporary, index=False)
+    _write_text(out / "index.html", _Html(rerun).page(title, preamble, sections))
     markdown = [f"# {title}", *(_markdown(b, rerun) for b in preamble)]
     markdown += [f"{n}. [{s.title}](#{s.anchor})" for n, s in enumerate(sections, 1)]
     for section in sections:
         markdown.append(f'<a id="{section.anchor}"></a>\n\n## {section.title}')
         markdown += [_markdown(b, rerun) for b in section.blocks]
-    (out / "report.md").write_text("\n\n".join(markdown) + "\n")
+    _write_text(out / "report.md", "\n\n".join(markdown) + "\n")
     save([b for b in blocks if isinstance(b, Figure)], out)
+
+
+def _write_text(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` whole or not at all (UTF-8, as the page declares)."""
+    with replaced(path, "report page") as temporary:
+        temporary.write_text(text, encoding="utf-8")
 
 
 def number(value: float | None, scale: float = 0.0) -> str:

@@ -1,0 +1,107 @@
+"""Fuzzing the environment of a command: whatever the streams and the disk do, one line at most.
+
+Hypothesis draws a fault (a reader that closed the pipe, standard output to ``/dev/full``, a
+closed standard error, ASCII-only streams, a full disk, an output under ``/sys``, behind a
+symbolic link or with a name that is not UTF-8) and a command that writes (``--version``,
+``list``, ``describe``, ``solve``, ``export``, ``run``), and runs it through
+`lawbench.views.cli.main` in this process. The promise is the command line's: exit 0, 2 or 4
+(1 for a broken pipe, Python's advice on SIGPIPE), at most one line on stderr, never a
+traceback or an internal error; a symbolic link is written through. The deeper run is slow.
+"""
+
+import contextlib
+import io
+import itertools
+import os
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from lawbench.views.cli import main
+
+
+@contextlib.contextmanager
+def _environment(fault: str):
+    """Standard streams and a file system with ``fault``; yields the captured stderr."""
+    stderr = io.StringIO()
+    opened = []
+    if fault == "broken pipe":
+        read, write = os.pipe()
+        os.close(read)
+        stdout = os.fdopen(write, "w")
+        opened.append(stdout)
+    elif fault == "stdout to /dev/full":
+        stdout = open("/dev/full", "w")
+        opened.append(stdout)
+    elif fault == "ascii streams":
+        stdout = io.TextIOWrapper(io.BytesIO(), encoding="ascii")
+        stderr = io.TextIOWrapper(io.BytesIO(), encoding="ascii")
+    else:
+        stdout = io.StringIO()
+    replace = os.replace
+
+    def full(*args):
+        raise OSError(28, os.strerror(28))
+
+    if fault == "full disk":
+        os.replace = full
+    saved = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = stdout, None if fault == "closed stderr" else stderr
+    try:
+        yield stderr
+    finally:
+        sys.stdout, sys.stderr = saved
+        os.replace = replace
+        for stream in opened:
+            with contextlib.suppress(OSError):
+                stream.close()
+
+
+FAULTS = [
+    "broken pipe", "stdout to /dev/full", "closed stderr", "ascii streams", "full disk",
+    "out under /sys", "symlink out", "non-UTF-8 out",
+]  # fmt: skip
+WRITERS = [
+    ["--version"],
+    ["list"],
+    ["describe", "moreau"],
+    ["solve", "newton", "three_ball_chain", "--json"],
+    ["export", "three_ball_chain", "-o", "{out}.json"],
+    ["run", "--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial",
+     "--quiet", "--out", "{out}.csv"],
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("examples", [12, pytest.param(60, marks=pytest.mark.slow)])
+def test_environment_faults_end_in_one_line_and_a_documented_code(tmp_path_factory, examples):
+    """Streams closed, broken, full or narrow, a full disk, outputs that cannot be written,
+    behind a symlink or not UTF-8: exit 0, 2 or 4 (1 for a broken pipe, Python's advice on
+    SIGPIPE), at most one line on stderr, never a traceback or an internal error."""
+
+    folder, counter = tmp_path_factory.mktemp("environment"), itertools.count()
+
+    @settings(max_examples=examples, deadline=None, derandomize=True)
+    @given(fault=st.sampled_from(FAULTS), argv=st.sampled_from(WRITERS))
+    def check(fault, argv):
+        out = str(folder / f"env{next(counter)}")
+        if fault == "out under /sys":
+            out = "/sys/lawbench"
+        elif fault == "non-UTF-8 out":
+            out += "\udcff\u00e9"
+        elif fault == "symlink out":
+            for ext in (".json", ".csv"):
+                Path(out + ext).symlink_to(f"{out}-target{ext}")
+        with _environment(fault) as stderr:
+            code = main([a.replace("{out}", out) for a in argv])
+        text = stderr.getvalue() if isinstance(stderr, io.StringIO) else ""
+        allowed = {0, 1, 2, 4} if fault == "broken pipe" else {0, 2, 4}
+        assert code in allowed, (fault, argv, code, text)
+        assert "Traceback" not in text and "internal error" not in text, text
+        assert len([line for line in text.splitlines() if line.strip()]) <= 1, text
+        if fault == "symlink out" and code == 0 and "-o" in argv:
+            assert Path(out + ".json").is_symlink() and Path(f"{out}-target.json").is_file()
+
+    check()
