@@ -215,6 +215,20 @@ def _blank(value: Any) -> bool:
     return value is None or (isinstance(value, float) and math.isnan(value))
 
 
+def _interval(row: dict[str, Any]) -> str:
+    """The bootstrap 95% interval of the median error; empty without an answer."""
+    if _blank(row["ci_low"]):
+        return ""
+    return f"{number(row['ci_low'])} – {number(row['ci_high'])}"
+
+
+def _pair(row: dict[str, Any]) -> str:
+    """The median errors of the normal and tangential parts; empty without an answer."""
+    if _blank(row["normal_error"]):
+        return ""
+    return f"{number(row['normal_error'])} / {number(row['tangential_error'])}"
+
+
 def _coefficients(row: dict[str, Any], fields: Sequence[str]) -> str:
     """The row's coefficients, each with its standard error where it was fitted."""
     shown = []
@@ -245,11 +259,9 @@ def ranking(study: MeasuredStudy) -> Table:
                 "law": row["law"],
                 "coefficients": row["coefficients"],
                 "median error": mark,
-                "95% CI": f"{number(row['ci_low'])} – {number(row['ci_high'])}",
+                "95% CI": _interval(row),
                 f"on the {study.common_count} common": number(row["common_error"]),
-                "normal / tangential": (
-                    f"{number(row['normal_error'])} / {number(row['tangential_error'])}"
-                ),
+                "normal / tangential": _pair(row),
                 "values": _coefficients(row, fields),
                 "cost [ms]": number(1e3 * row["cost_s"]),
                 "fitted on": row["fitted_on"],
@@ -458,6 +470,14 @@ def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
         rms=[_rms_mark(row, failures.get(row["law"], "")) for row in rms.to_dict("records")]
     )
     reversal = kharaz_curves.reversal(curves)
+    reversal_shown = pd.DataFrame(
+        {
+            "law": reversal["law"],
+            "reverses": [_reverses(value) for value in reversal["reverses"]],
+            "lowest contact angle [deg]": [number(a, 90.0) for a in reversal["lowest_angle"]],
+            "at incidence [deg]": [number(a) for a in reversal["at_incidence"]],
+        }
+    )
     return [
         figure,
         Table(
@@ -473,9 +493,17 @@ def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
             "Whether each law's contact point leaves the anvil moving backwards (contact angle "
             f"below -{kharaz_curves.REVERSED:g} deg) somewhere in the sticking range, as "
             "measured (down to -8.5 deg at 20 deg): the lowest angle and its incidence.",
+            reversal_shown,
             reversal,
         ),
     ]
+
+
+def _reverses(value: Any) -> Mark:
+    """The reversal cell: the law's answer, or no answer in the sticking range."""
+    if value is None or _blank(value):
+        return Mark("no answer", Verdict.NUMERICAL_FAILURE, "no solve of the sticking range")
+    return Mark("yes" if value else "no", Verdict.HOLDS, "")
 
 
 def _rms_mark(row: dict[str, Any], error: str) -> Mark:
