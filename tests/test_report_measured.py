@@ -12,6 +12,7 @@ from lawbench.measurements import MEASUREMENTS, MeasurementSet, Processing
 from lawbench.views.report import QUICK, build, measured
 from lawbench.views.report.marks import Mark
 from lawbench.views.report.page import Figure, Table
+from lawbench.views.report.runs import Context
 
 ELLIPSE = MEASUREMENTS.get("ellipse")
 LAWS_STUDIED = ("newton", "whittaker")
@@ -74,3 +75,15 @@ def test_the_first_screen_links_the_section_and_the_page_shows_it(
     assert (out / "measured_tiny.csv").exists()
     assert (out / "measured_tiny_scatter.svg").exists()
     assert "Kharaz" in page  # the curves' absence is said, not hidden
+
+
+def test_the_studies_run_in_workers_on_the_sets_asked_for(tmp_path):
+    config = dataclasses.replace(
+        QUICK, workers=1, laws=("whittaker", "newton"), measurements=("kharaz", "unknown")
+    )
+    found = measured.results(Context(config, tmp_path))
+    assert list(found.studies) == ["kharaz"]
+    assert any("unknown" in note for note in found.notes)
+    study = found.studies["kharaz"]
+    assert study.table.iloc[0]["law"] == "whittaker"
+    assert set(found.kharaz["law"]) == {"whittaker"}  # the frictional laws asked for

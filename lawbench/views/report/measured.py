@@ -42,7 +42,7 @@ from lawbench.studies.guard import TIME_OUT, Guard, Result
 from lawbench.views.report import plots
 from lawbench.views.report.marks import Mark
 from lawbench.views.report.page import Block, Figure, Section, Table, number
-from lawbench.views.report.runs import Context
+from lawbench.views.report.runs import Context, registered
 
 ANCHOR, TITLE, VIEWS = "measured", "Against measurements", ()
 # Wall-clock seconds one set's study (or Kharaz's curves) may take, per mode.
@@ -72,6 +72,7 @@ class Found:
     kharaz: pd.DataFrame | str = "not run"
     seconds: float = 0.0
     workers: int = 1
+    notes: list[str] = field(default_factory=list)
 
 
 _FOUND: weakref.WeakKeyDictionary[Context, Found] = weakref.WeakKeyDictionary()
@@ -93,10 +94,8 @@ def results(ctx: Context) -> Found:
     quick = config.mode == "quick"
     names = [law.name for law in ctx.laws]
     found = Found(quick, workers=config.workers)
-    try:
-        found.sets = {name: MEASUREMENTS.get(name) for name in MEASUREMENTS.names()}
-    except Exception as exc:  # a set that fails to load leaves the others and the curves
-        found.studies["measurement sets"] = f"{type(exc).__name__}: {exc}"
+    sets, found.notes = registered(MEASUREMENTS, config.measurements)
+    found.sets = {s.name: s for s in sets}
     frictional = [name for name in kharaz_curves.frictional_laws() if name in names]
     incidences = kharaz_curves.digitized_incidences() if quick else None
     with Guard(config.workers, BUDGET_S[config.mode]) as guard:
@@ -545,7 +544,8 @@ def build(ctx: Context) -> Section:
         "Each law's contact coefficients fitted on a measured set's training impacts and "
         "judged on its test impacts; the error of an impact is the kinetic norm of the "
         "predicted minus the measured velocity after it, relative to the velocity before. "
-        + _mode_text(found)
+        + _mode_text(found),
+        *(f"Note: {note}." for note in found.notes),
     ]
     for name, study in found.studies.items():
         if isinstance(study, MeasuredStudy):
