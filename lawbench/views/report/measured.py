@@ -204,10 +204,14 @@ def verdict(row: dict[str, Any]) -> Mark:
     if not answered and row["refused"]:
         return Mark(number(row["median_error"]), Verdict.REFUSED, reason)
     if not answered or row["failed"]:
-        budget = "budget" in reason.lower() or "stopped by" in reason
-        failed = Verdict.BUDGET if budget else Verdict.NUMERICAL_FAILURE
-        return Mark(number(row["median_error"]), failed, reason or "no answer")
+        return Mark(number(row["median_error"]), _failed(reason), reason or "no answer")
     return Mark(number(row["median_error"]), Verdict.HOLDS, reason or "every judged impact")
+
+
+def _failed(reason: str) -> Verdict:
+    """A failure's verdict: budget where its reason names a budget or the guard that stopped it."""
+    budget = "budget" in reason.lower() or "stopped by" in reason
+    return Verdict.BUDGET if budget else Verdict.NUMERICAL_FAILURE
 
 
 def _blank(value: Any) -> bool:
@@ -509,9 +513,7 @@ def _rms_mark(row: dict[str, Any], error: str) -> Mark:
     """The RMS cell: holds where every point answered, else the failure and its message."""
     if not row["failed"]:
         return Mark(number(row["rms"]), Verdict.HOLDS, f"{row['points']} points")
-    budget = "budget" in error.lower() or "stopped by" in error
-    failed = Verdict.BUDGET if budget else Verdict.NUMERICAL_FAILURE
-    return Mark(number(row["rms"]), failed, f"{row['failed']} points failed: {error}")
+    return Mark(number(row["rms"]), _failed(error), f"{row['failed']} points failed: {error}")
 
 
 def _mode_text(found: Found) -> str:
