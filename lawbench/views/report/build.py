@@ -28,6 +28,7 @@ from lawbench.studies.guard import Guard
 from lawbench.views.report import (
     dispersion,
     inside,
+    measured,
     outcomes,
     paradoxes,
     stability,
@@ -41,6 +42,7 @@ from lawbench.views.report.runs import Context, label
 
 SECTIONS: tuple[ModuleType, ...] = (
     summary,
+    measured,
     outcomes,
     tradeoff,
     stability,
@@ -76,7 +78,7 @@ def build(out: Path, config: Config) -> Path:
         drawing.start()  # the drawing workers start up while the sections are built
         sections = [_section(module, ctx) for module in SECTIONS]
         seconds = time.perf_counter() - start
-        preamble = [*_preamble(ctx, config, seconds), *headline(ctx)]
+        preamble = [measured.first_screen(ctx), *_preamble(ctx, config, seconds), *headline(ctx)]
         write_page(out, TITLE, preamble, sections, ctx.rerun, _save(drawing))
     return out
 

@@ -61,6 +61,8 @@ class Config:
         Restrict every study to these laws and scenes; None for every registered one.
     studies : tuple of str or None
         Run only these studies; None for every study a section draws.
+    measurements : tuple of str or None
+        Judge the laws on these measurement sets only; None for every registered one.
     """
 
     mode: str
@@ -71,6 +73,7 @@ class Config:
     laws: tuple[str, ...] | None = None
     cases: tuple[str, ...] | None = None
     studies: tuple[str, ...] | None = None
+    measurements: tuple[str, ...] | None = None
 
     def rerun(self, out: str) -> str:
         """The command that writes this report again."""
