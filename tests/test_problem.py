@@ -192,7 +192,8 @@ def test_a_law_never_returns_a_non_finite_answer(field, value):
             outcome = lawbench.Outcome.from_impulses(problem, np.zeros(1))
             return dataclasses.replace(outcome, **{field: value})
 
-    problem = ImpactProblem.from_arrays(np.eye(2), [[-1.0], [1.0]], [1.0, 0.0])
+    # A tangential row (frictionless: mu = 0) gives Pt its one entry.
+    problem = ImpactProblem.from_arrays(np.eye(2), [[-1.0], [1.0]], [1.0, 0.0], [[0.0], [1.0]])
     with pytest.raises(lawbench.SolverFailure, match=f"non-finite {field}"):
         Broken().resolve(problem)
 

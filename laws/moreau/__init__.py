@@ -78,7 +78,8 @@ frictionless formulations above do not depend on it:
   QP, it can stall where the Delassus matrix is singular (more contact directions than
   coordinates), where the fixed point's interior-point steps still find the contact states.
   Diagnostics: ``sweeps`` (and ``iterations``, the same), ``polished``, ``fc3d_error``.
-- ``auto`` (default): the fixed point on an impact of at most ``FIXED_POINT_MAX`` contacts,
+- ``auto`` (default): at one contact Gauss-Seidel's exact local solver (take-off, stick or
+  slip in closed form); the fixed point on an impact of 2 to ``FIXED_POINT_MAX`` contacts,
   where a cone QP is cheap and settles the cases of several solutions; Gauss-Seidel with the
   polish on a larger impact and in contact space, then the fixed point where the sweeps become
   stationary above ``tol`` or run out of their bound: Acary, Brémond and Huber's comparison of
@@ -222,8 +223,9 @@ class Moreau(Law):
             "auto",
             "the solver of the frictional problem: fixed point over cone QPs (clarabel), "
             "nonsmooth Gauss-Seidel with an exact solver per contact, or auto: the fixed point "
-            f"up to {FIXED_POINT_MAX} contacts of an impact, Gauss-Seidel beyond and in contact "
-            "space, then the fixed point where the sweeps stall or run out (Acary, Bremond and "
+            f"on 2 to {FIXED_POINT_MAX} contacts of an impact, Gauss-Seidel on one, beyond and "
+            "in contact space, then the fixed point where the sweeps stall or run out (Acary, "
+            "Bremond and "
             "Huber 2018; Siconos' default solver is NSGS)",
             kind="str",
             choices=("auto", "fixed_point", "nsgs"),

@@ -27,14 +27,15 @@ def methods_for(options: dict[str, Any], m: int, in_contact_space: bool) -> tupl
     """The methods to try in turn on a frictional problem of ``m`` contacts.
 
     An explicit ``method`` alone. ``auto``: the fixed point for Anitescu's relaxation (one cone
-    QP) and for an impact of at most `FIXED_POINT_MAX` contacts; otherwise Gauss-Seidel, then
+    QP) and for an impact of 2 to `FIXED_POINT_MAX` contacts; otherwise Gauss-Seidel (at one
+    contact its exact local solver: take-off, stick or slip in closed form), then
     the fixed point where the sweeps become stationary above ``tol`` or run out of their bound
     (on a singular Delassus matrix, whose contact states the interior-point steps still find).
     """
     method = options["method"]
     if method != "auto":
         return (method,)
-    if options["friction"] == "relaxed" or (not in_contact_space and m <= FIXED_POINT_MAX):
+    if options["friction"] == "relaxed" or (not in_contact_space and 1 < m <= FIXED_POINT_MAX):
         return ("fixed_point",)
     return ("nsgs", "fixed_point")
 
