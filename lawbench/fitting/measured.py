@@ -66,8 +66,8 @@ START = {"e": 0.5, "e_t": 0.0, "mu": 0.2, "tangential_stiffness_ratio": MINDLIN_
 COSTLY_FIT = 8
 COSTLY_JUDGE = 40
 # The same in the quick mode.
-QUICK_COSTLY_FIT = 4
-QUICK_COSTLY_JUDGE = 10
+QUICK_COSTLY_FIT = 2
+QUICK_COSTLY_JUDGE = 4
 # The impacts of each half the quick mode keeps.
 QUICK = 40
 # The ``coefficients`` of a row whose coefficients were fitted on the training impacts.

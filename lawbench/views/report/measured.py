@@ -22,7 +22,6 @@ impact and the fine grid of incidences.
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 import weakref
@@ -49,10 +48,10 @@ ANCHOR, TITLE, VIEWS = "measured", "Against measurements", ()
 BUDGET_S = {"quick": 240.0, "full": 6.0 * 3600.0}
 # The roles of the three rows drawn against the measurements, in the order of the legend.
 ROLES = ("best law", "best rigid law", "best compliant law")
-# Training and test impacts of a law that reads stiffness in the quick report, and the seconds
-# its study may take there: a fit solves each impact a hundred times or more, at 0.03 to 0.5 s a
-# solve, so the quick page shows what such a law gives in that time and the full page the rest.
-STIFF_QUICK = (2, 4)
+# Seconds the study of a law that reads stiffness may take in the quick report: a fit solves
+# each impact a hundred times or more, at 0.03 to 0.5 s a solve, so the quick page shows what
+# such a law gives in that time (on `lawbench.fitting.measured.QUICK_COSTLY_FIT` and
+# `QUICK_COSTLY_JUDGE` impacts of the quick subsample) and the full page the rest.
 STIFF_QUICK_S = 30.0
 QUANTITY_LABELS = {
     "tangential_restitution": "tangential restitution vx+/vx- [-]",
@@ -120,46 +119,21 @@ def results(ctx: Context) -> Found:
 
 def tasks(
     measurement_set: MeasurementSet, names: Sequence[str], quick: bool
-) -> list[tuple[str | MeasurementSet, list[str], float]]:
+) -> list[tuple[str, list[str], float]]:
     """The studies of one set: the laws that read no stiffness together, then each other law.
 
     A law that reads stiffness integrates each impact in time, hundreds of times slower than
     a closed form: it runs alone, so that the pool spreads the set's work, and in the quick
-    report on `STIFF_QUICK` evenly spaced impacts of each half within `STIFF_QUICK_S`, the
-    impacts taken among the quick subsample so that every row is ranked on common impacts.
-    Each task is ``(set, laws, seconds)``, the set by name where it is the registered one.
+    report within `STIFF_QUICK_S`. Each task is ``(set name, laws, seconds)``.
     """
     mode = "quick" if quick else "full"
     stiff = [name for name in names if LAWS.get(name).tags.stiffness]
     rigid = [name for name in names if name not in stiff]
-    chosen_set = _subsample(measurement_set) if quick else measurement_set.name
     seconds = STIFF_QUICK_S if quick else BUDGET_S[mode]
     return [
         (measurement_set.name, rigid, BUDGET_S[mode]),
-        *((chosen_set, [name], seconds) for name in stiff),
+        *((measurement_set.name, [name], seconds) for name in stiff),
     ]
-
-
-def _subsample(measurement_set: MeasurementSet) -> MeasurementSet:
-    """The set cut to `STIFF_QUICK` evenly spaced impacts of each half of the quick subsample."""
-    fit, judge = STIFF_QUICK
-    train = measured.evenly(measured.evenly(measurement_set.train, measured.QUICK), fit)
-    test = measured.evenly(measured.evenly(measurement_set.test, measured.QUICK), judge)
-    impacts = [*train, *test]
-    mask = np.arange(len(impacts)) < len(train)
-    processing = measurement_set.processing
-    return MeasurementSet(
-        measurement_set.name,
-        measurement_set.summary,
-        measurement_set.source,
-        functools.partial(_given, impacts, mask, processing),
-        measurement_set.facts,
-    )
-
-
-def _given(impacts: list[Any], mask: np.ndarray, processing: Any) -> tuple[Any, ...]:
-    """The load of a set cut by `_subsample` (a module function: it goes to a worker)."""
-    return impacts, mask, processing
 
 
 def joined(parts: Sequence[tuple[list[str], Result]], note: str = "") -> MeasuredStudy | str:
@@ -521,7 +495,8 @@ def _mode_text(found: Found) -> str:
         sample = (
             f"the quick report fits and judges {measured.QUICK} evenly spaced impacts of each "
             "half of each set; a law that reads stiffness (it integrates each impact in time) "
-            f"is fitted on {STIFF_QUICK[0]} and judged on {STIFF_QUICK[1]} of them within "
+            f"is fitted on {measured.QUICK_COSTLY_FIT} and judged on "
+            f"{measured.QUICK_COSTLY_JUDGE} of them within "
             f"{STIFF_QUICK_S:g} s, a budget mark where that is too little; Kharaz's curves are "
             "drawn at the digitized incidences only. `lawbench report --full` runs every "
             "impact and the fine grid"
