@@ -1,10 +1,11 @@
-"""The comparison report: every law on every scene, side by side, in seven sections.
+"""The comparison report: every law on every scene and every measured set, side by side.
 
 `write_report` runs every registered study a section draws (`lawbench.views.report.config.view`) and
 writes a self-contained folder: ``index.html`` and ``report.md`` with the same content, every
 figure as PNG and SVG with the CSV of its data, every table as CSV, every study's table in
 ``runs/``. Sections, each a view of study tables: summary matrix of the checks with the
-findings, outcomes beside the ground truth and the references, speed versus accuracy (model
+findings, every law against the measured impacts (fitted on one half of each set, judged on the
+other), outcomes beside the ground truth and the references, speed versus accuracy (model
 error and numerical error), stability at the extremes, energy-increase maps, dispersion and
 continuity, and paths inside an impact. Every cell carries a verdict; the headline counts the
 unexplained ones. A law or scene that is missing or fails is reported, never a crash.
