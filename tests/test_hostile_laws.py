@@ -92,15 +92,6 @@ def _runs_out_of_memory(self, problem, options):
     raise MemoryError
 
 
-@pytest.mark.parametrize(
-    ("body", "said"),
-    [(_exits, "sys.exit"), (_interrupts, "KeyboardInterrupt"), (_runs_out_of_memory, "memory")],
-)
-def test_exit_interrupt_and_memory_in_a_law_are_its_failure(body, said):
-    with pytest.raises(SolverFailure, match=f"broken_test_law: .*{said}"):
-        lawbench.solve(broken(body), ball())
-
-
 def test_the_users_ctrl_c_still_interrupts():
     def pressed(self, problem, options):
         os.kill(os.getpid(), signal.SIGINT)
@@ -128,11 +119,20 @@ def _writes_options(self, problem, options):
 
 
 @pytest.mark.parametrize(
-    ("body", "what"),
-    [(_writes_velocity, "problem"), (_writes_contact, "problem"), (_writes_options, "options")],
+    ("body", "said"),
+    [
+        (_exits, "sys.exit"),
+        (_interrupts, "KeyboardInterrupt"),
+        (_runs_out_of_memory, "memory"),
+        (_writes_velocity, "wrote into the problem"),
+        (_writes_contact, "wrote into the problem"),
+        (_writes_options, "wrote into the options"),
+    ],
 )
-def test_a_law_that_writes_into_its_input_is_refused(body, what):
-    with pytest.raises(SolverFailure, match=f"wrote into the {what}"):
+def test_a_law_that_exits_runs_out_of_memory_or_writes_into_its_input_fails(body, said):
+    """sys.exit, KeyboardInterrupt and MemoryError in a law, or a write into what it was given,
+    are that law's failure, named."""
+    with pytest.raises(SolverFailure, match=f"broken_test_law: .*{said}"):
         lawbench.solve(broken(body), ball())
 
 

@@ -137,7 +137,7 @@ STEPPING = {
     "lzb": ("three_ball_chain", {}, {}),
     "jia": ("two_balls_wall", {}, {}),
     "darboux_keller": None,
-    "moreau": ("lamina", {}, {"friction": "coulomb"}),
+    "moreau": ("lamina", {}, {"friction": "coulomb", "method": "fixed_point"}),
     "sequential": ("two_balls_wall", {"e": 0.0}, {}),
 }
 

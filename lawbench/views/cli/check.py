@@ -7,7 +7,6 @@ import sys
 
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
-from lawbench.core.guards import end_process_when_stuck
 from lawbench.core.law import LAWS, Law
 from lawbench.views.cli.main import MAX_REPEATS, CheckFailed, _count, _names
 
@@ -29,18 +28,16 @@ def arguments(check: argparse.ArgumentParser) -> None:
         help=f"seeded random problems (3; at most {MAX_REPEATS})",
     )
     check.add_argument("--json", action="store_true", help="print the table as JSON records")
-    check.set_defaults(run=run)
+    check.set_defaults(run=run, solves=True)
 
 
 def run(args: argparse.Namespace) -> None:
     """Print the law's conformance table; raise `CheckFailed` when it does not pass.
 
     Every solve is bounded from outside (`lawbench.core.trial.make_trial`); a law stuck in
-    native code past that bound ends this command (`lawbench.core.guards.end_process_when_stuck`).
+    native code past that bound ends this command (``solves``: `lawbench.views.cli.main`).
     """
     from lawbench.studies.conformance import check_law
-
-    end_process_when_stuck()
 
     cases = _names(args.cases, "--cases", CASES)
     report = check_law(_law_object(args.law), cases=cases, random_problems=args.random)

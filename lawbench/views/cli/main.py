@@ -22,7 +22,7 @@ from lawbench.core.errors import (
     NotApplicable,
     SolverFailure,
 )
-from lawbench.core.guards import watch_interrupts
+from lawbench.core.guards import end_process_when_stuck, watch_interrupts
 from lawbench.core.registry import Registry
 from lawbench.files.paths import NO_ROOM
 from lawbench.studies.guard import BUDGET_S, EXECUTORS
@@ -296,6 +296,9 @@ def _main(argv: Sequence[str] | None) -> int:
         return int(exit_.code or 0)
     except MemoryError:
         return _out_of_memory()
+    if getattr(args, "solves", False):
+        # A command that solves: a law stuck in native code past its bound ends the process.
+        end_process_when_stuck()
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")

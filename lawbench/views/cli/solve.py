@@ -13,7 +13,6 @@ import numpy as np
 from lawbench.checks import CheckResult, run_checks
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import InvalidProblem, SolverFailure
-from lawbench.core.guards import end_process_when_stuck
 from lawbench.core.trial import Trial, make_trial
 from lawbench.core.verdicts import Verdict
 from lawbench.files.facts import ProblemFile
@@ -50,16 +49,15 @@ def arguments(solve: argparse.ArgumentParser) -> None:
         help="stop the solve after S seconds of wall time (exit code 4)",
     )
     solve.add_argument("--json", action="store_true", help="print one JSON object")
-    solve.set_defaults(run=run)
+    solve.set_defaults(run=run, solves=True)
 
 
 def run(args: argparse.Namespace) -> None:
     """Solve, then print the record (text, or one JSON object under ``--json``).
 
     The solve is bounded from outside (`lawbench.core.trial.make_trial`); a law stuck in
-    native code past that bound ends this command (`lawbench.core.guards.end_process_when_stuck`).
+    native code past that bound ends this command (``solves``: `lawbench.views.cli.main`).
     """
-    end_process_when_stuck()
     case, params = _scene_or_problem(args)
     options = _assignments(args.option, "--option")
     if isinstance(case, ProblemFile) and isinstance(case.problem, ContactProblem):
