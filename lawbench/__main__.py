@@ -2,6 +2,6 @@
 
 import sys
 
-from lawbench.views.cli import main
+from lawbench.views.cli import program
 
-sys.exit(main())
+sys.exit(program())

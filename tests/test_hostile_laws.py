@@ -20,6 +20,7 @@ from test_plugins import distribution
 
 import lawbench
 from lawbench.checks import run_checks
+from lawbench.core import guards
 from lawbench.core import registry as registry_module
 from lawbench.core.errors import BudgetExceeded, SolverFailure
 from lawbench.core.guards import WALL_CLOCK, alarm
@@ -312,6 +313,13 @@ def test_solve_stops_a_law_that_never_answers(hostile_env, law):
     assert done.returncode == 4, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and WALL_CLOCK in done.stderr
     assert time.monotonic() - start < 20
+
+
+def test_main_called_as_a_function_never_ends_its_callers_process(capsys):
+    """Only the ``lawbench`` program owns its process: a caller of `main` keeps its own."""
+    assert main(["solve", "newton", "three_ball_chain"]) == 0
+    capsys.readouterr()
+    assert guards._Watchdog.thread is None
 
 
 def test_check_and_run_stop_a_law_that_sleeps(hostile_env, tmp_path):

@@ -35,7 +35,8 @@ def run(args: argparse.Namespace) -> None:
     """Print the law's conformance table; raise `CheckFailed` when it does not pass.
 
     Every solve is bounded from outside (`lawbench.core.trial.make_trial`); a law stuck in
-    native code past that bound ends this command (``solves``: `lawbench.views.cli.main`).
+    native code past that bound ends the ``lawbench`` program (``solves``:
+    `lawbench.views.cli.main`).
     """
     from lawbench.studies.conformance import check_law
 

@@ -224,8 +224,12 @@ def _command(argv: Sequence[str]) -> str | None:
     return next((word for word in argv if not word.startswith("-")), None)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None, *, own_process: bool = False) -> int:
     """Run the command line; return the exit code.
+
+    With ``own_process`` (the ``lawbench`` program), a command that solves ends the process
+    when a law stays stuck in native code past its wall-clock bound; called as a function, a
+    stuck law is left to the caller's own guard.
 
     The streams are handled as Python's command-line tools handle them: a character the
     terminal's encoding lacks (or a file name that is not UTF-8) is written escaped; a reader
@@ -235,7 +239,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     _escaping_streams()
     try:
-        code = _main(argv)
+        code = _main(argv, own_process)
         if sys.stdout is not None:
             sys.stdout.flush()  # a full device fails here, not in the interpreter's exit
     except BrokenPipeError:
@@ -245,6 +249,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         _silence_stdout()
         return _os_error(exc)
     return code
+
+
+def program() -> int:
+    """The ``lawbench`` program: `main` on this process's arguments, owning the process."""
+    return main(own_process=True)
 
 
 def _os_error(exc: OSError) -> int:
@@ -284,7 +293,7 @@ def _say(line: str) -> None:
         pass
 
 
-def _main(argv: Sequence[str] | None) -> int:
+def _main(argv: Sequence[str] | None, own_process: bool) -> int:
     """`main` without its handling of the standard streams."""
     # The run machinery reports damaged chunks through logging: one line on stderr each.
     logging.basicConfig(format="lawbench: %(message)s", level=logging.WARNING)
@@ -296,7 +305,7 @@ def _main(argv: Sequence[str] | None) -> int:
         return int(exit_.code or 0)
     except MemoryError:
         return _out_of_memory()
-    if getattr(args, "solves", False):
+    if own_process and getattr(args, "solves", False):
         # A command that solves: a law stuck in native code past its bound ends the process.
         end_process_when_stuck()
     try:

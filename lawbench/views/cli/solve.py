@@ -56,7 +56,8 @@ def run(args: argparse.Namespace) -> None:
     """Solve, then print the record (text, or one JSON object under ``--json``).
 
     The solve is bounded from outside (`lawbench.core.trial.make_trial`); a law stuck in
-    native code past that bound ends this command (``solves``: `lawbench.views.cli.main`).
+    native code past that bound ends the ``lawbench`` program (``solves``:
+    `lawbench.views.cli.main`).
     """
     case, params = _scene_or_problem(args)
     options = _assignments(args.option, "--option")
