@@ -40,9 +40,11 @@ ROUNDING = 1e-12
 CHROMIUM = Path("/usr/bin/chromium")
 CLASSES = {str(v) for v in Verdict}
 
-# The closed-form laws and two single-contact laws on the scenes every section needs.
+# The closed-form laws and two single-contact laws on the scenes every section needs; the section
+# against measurements has its own tests (test_report_measured.py) and draws Kharaz's curves here.
 SMALL = dataclasses.replace(
     QUICK,
+    measurements=(),
     laws=(*CLOSED_FORM, "brach", "darboux_keller"),
     cases=(
         "three_ball_chain",

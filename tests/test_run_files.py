@@ -67,7 +67,11 @@ def whole(tmp_path_factory):
     return folder / "cut.parquet", time.monotonic() - begun
 
 
-@pytest.mark.parametrize("seed", range(5))
+# Two moments in the default run; three more in the slow profile.
+KILL_SEEDS = [0, 1, *(pytest.param(seed, marks=pytest.mark.slow) for seed in range(2, 5))]
+
+
+@pytest.mark.parametrize("seed", KILL_SEEDS)
 def test_a_process_pool_run_killed_anywhere_resumes_to_the_same_rows(tmp_path, whole, seed):
     reference, seconds = whole
     process = start(tmp_path)

@@ -23,7 +23,7 @@ from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.law import LAWS
 from lawbench.studies.grid import RunSpec
-from lawbench.studies.runner import Task, compute
+from lawbench.studies.runner import Executor, Task
 
 # The repository's committed baselines (lawbench/studies/ is two folders below its top).
 BASELINES = Path(__file__).resolve().parents[2] / "reports" / "baselines"
@@ -47,18 +47,23 @@ COLUMNS = [*IDENTITY, "error_class", *QUANTITIES]
 
 
 def compute_table(
-    spec: RunSpec, laws: Sequence[str] | None, cases: Sequence[str] | None
+    spec: RunSpec, laws: Sequence[str] | None, cases: Sequence[str] | None, workers: int = 1
 ) -> pd.DataFrame:
     """Records of the baseline grid (restricted to ``laws`` and ``cases`` when given), as text.
 
-    Vectors are JSON and numbers their shortest exact repr, so the CSV keeps every digit.
+    Vectors are JSON and numbers their shortest exact repr, so the CSV keeps every digit. With
+    ``workers`` above one the rows are computed by that many worker processes; the table is the
+    same.
     """
     jobs = [
         job
         for job in spec.rows()
         if (not laws or job.law in laws) and (not cases or job.case in cases)
     ]
-    records = [compute(Task(index, job)) for index, job in enumerate(jobs)]
+    tasks = [Task(index, job) for index, job in enumerate(jobs)]
+    with Executor("processes" if workers > 1 else "serial", workers) as executor:
+        rows = dict(executor.run(tasks))
+    records = [rows[position] for position in range(len(tasks))]
     table = pd.DataFrame(records).reindex(columns=COLUMNS)
     table["T_plus"] = table["T_plus"].map(lambda x: "" if pd.isna(x) else repr(float(x)))
     return table.fillna("").astype(str)
@@ -124,17 +129,19 @@ def regress(
     cases: Sequence[str] | None = None,
     update: bool = False,
     folder: Path = BASELINES,
+    workers: int = 1,
 ) -> pd.DataFrame:
     """Recompute the baseline grid; return the drift (empty when every law holds).
 
-    With ``update`` the baselines are rewritten and the returned table lists what changed.
+    With ``update`` the baselines are rewritten and the returned table lists what changed;
+    ``workers`` worker processes compute the grid.
     """
     for name in laws or ():
         LAWS.get(name)  # an unknown name is an error, never an empty selection that holds
     for name in cases or ():
         CASES.get(name)
     spec, tolerances = load(folder)
-    obtained = compute_table(spec, laws, cases)
+    obtained = compute_table(spec, laws, cases, workers)
     drift = []
     for law, table in obtained.groupby("law", sort=True):
         path = folder / f"{law}.csv"

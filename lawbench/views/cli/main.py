@@ -159,14 +159,19 @@ def _names(text: str | None, option: str, registry: Registry) -> list[str] | Non
     return names
 
 
-def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
-    """The options of the commands that run many cells: executor, workers, guard."""
-    parser.add_argument("--executor", choices=EXECUTORS, default=default)
+def _workers_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    """The option ``--workers``: ``what`` runs in that many processes (default one per core)."""
     parser.add_argument(
         "--workers",
         type=_count(1, MAX_WORKERS),
-        help=f"worker processes, at most {MAX_WORKERS} (default: one per core)",
+        help=f"{what}, at most {MAX_WORKERS} (default: one per core)",
     )
+
+
+def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
+    """The options of the commands that run many cells: executor, workers, guard."""
+    parser.add_argument("--executor", choices=EXECUTORS, default=default)
+    _workers_argument(parser, "worker processes")
     parser.add_argument(
         "--max-seconds",
         type=_seconds,

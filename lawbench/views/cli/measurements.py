@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 
 from lawbench.core.errors import InvalidProblem
-from lawbench.views.cli.main import MAX_WORKERS, _count, _path
+from lawbench.views.cli.main import _path, _workers_argument
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = (
@@ -64,12 +64,7 @@ def arguments(parser: argparse.ArgumentParser) -> None:
         help="the study on 40 evenly spaced impacts of each half (fewer for the laws that "
         "integrate in time)",
     )
-    parser.add_argument(
-        "--workers",
-        type=_count(1, MAX_WORKERS),
-        help=f"processes that study the laws side by side, at most {MAX_WORKERS} (default: one "
-        "per core)",
-    )
+    _workers_argument(parser, "processes that study the laws side by side")
     parser.add_argument(
         "--out",
         type=_path,

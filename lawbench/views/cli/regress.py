@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import os
 
 from lawbench.core.case import CASES
 from lawbench.core.law import LAWS
-from lawbench.views.cli.main import Drift, _names
+from lawbench.views.cli.main import Drift, _names, _workers_argument
 
 # The command's name and the settings of its parser (`lawbench.views.cli.build_parser`).
 COMMAND = ("regress", {"help": "compare every law with its baseline"})
@@ -17,6 +18,7 @@ def arguments(regress: argparse.ArgumentParser) -> None:
     regress.add_argument("--update", action="store_true", help="rewrite the baselines")
     regress.add_argument("--laws", help="comma-separated laws")
     regress.add_argument("--cases", help="comma-separated cases")
+    _workers_argument(regress, "processes that compute the baseline grid")
     regress.set_defaults(run=run)
 
 
@@ -26,7 +28,8 @@ def run(args: argparse.Namespace) -> None:
 
     laws = _names(args.laws, "--laws", LAWS)
     cases = _names(args.cases, "--cases", CASES)
-    drift = regress(laws, cases, update=args.update)
+    workers = args.workers or os.cpu_count() or 1
+    drift = regress(laws, cases, update=args.update, workers=workers)
     if args.update:
         print(f"baselines rewritten; {len(drift)} quantities changed")
         if len(drift):
