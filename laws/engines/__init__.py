@@ -12,7 +12,7 @@ import importlib
 from lawbench.core.law import LAWS
 
 # The engine modules, each named after the package it drives.
-ENGINES = ("pybullet",)
+ENGINES = ("mujoco", "pybullet")
 
 for _engine in ENGINES:
     try:
