@@ -10,22 +10,25 @@ calculateCombinedFriction, the products of the bodies' coefficients, friction cl
 
 Conventions: the common stepping rule of the engine laws (`lawbench.laws.engines._base`);
 Bullet's positions and velocities are the bodies' centres of mass and its angular velocities
-are in the world frame, as the geometry's. A contact point reports its normal force and two
-lateral friction forces over the step just taken (getContactPoints: normalForce along
-contactNormalOnB, which points from B to A, and lateralFriction1, 2 along their directions,
-the forces on A with the opposite sign); the impulse of a step is the force times the step.
-Gravity and Bullet's velocity damping (linearDamping, angularDamping, 0.04 by default) are off:
-they act in flight, not in the impact. Joints: a free joint is a Bullet base with mass, a fixed
-one a base without; Bullet has no planar joint, so a planar body is a free one whose contact
-forces lie in its plane of motion (the rocking block's contact points lie in the plane through
-its centre of mass, so its motion stays planar); hinges and slides are not built.
+are in the world frame, as the geometry's. A contact point reports the forces of the step just
+taken (getContactPoints): normalForce along contactNormalOnB (from B to A) and lateralFriction1
+and 2 along lateralFrictionDir1 and 2, together the force on A; a step's impulse is that force
+times the step. Gravity and Bullet's velocity damping (linearDamping, angularDamping, 0.04 by
+default) are off: they act in flight, not in the impact. Solves share a client per thread and
+setting (a client takes 50 ms to connect), which sorts its overlapping pairs
+(deterministicOverlappingPairs) so that the solver meets the contacts in the same order whatever
+the client solved before. Joints: a free joint is a Bullet base with mass, a fixed one a base
+without; Bullet has no planar joint, so a planar body is a free one whose contact forces lie in
+its plane of motion (the rocking block's contact points lie in the plane through its centre of
+mass, so its motion stays planar); hinges and slides are not built.
 
 Settings (option ``settings``):
 
 - ``default``, what a user gets: Bullet's defaults (setPhysicsEngineParameter untouched but the
-  step, 1/240 s, the documented default), and each body given the scene's coefficients as the
-  Quickstart describes them, a property of the body (changeDynamics' restitution and
-  lateralFriction; a body in contacts of different coefficients takes their mean). Bullet then
+  step, 1/240 s, the documented default, and the order of the pairs), and each body given the
+  scene's coefficients as the Quickstart describes them, a property of the body (changeDynamics'
+  restitution and lateralFriction; a body in contacts of different coefficients takes their
+  mean). Bullet then
   multiplies the two bodies' coefficients: a contact of restitution e and friction mu acts with
   e^2 and mu^2. Bullet's box-plane contact manifold gains one point per step, so a box lands on
   one corner point first.
@@ -40,6 +43,13 @@ Settings (option ``settings``):
   Bullet's restitution is then Moreau's per-contact rule on each step's velocities,
   ``0 <= un+ + e un- _|_ Pn >= 0``, with Coulomb's friction on the impulses in its circular
   cone (enableConeFriction, on by default; off, a pyramid lets |Pt| reach sqrt(2) mu Pn).
+
+Measured against Moreau's law, relative to the largest pre-impact velocity: tuned, 1e-15 on the
+chains, the sphere on a wall (with and without spin, sticking or sliding) and the rocking block.
+At the defaults the elastic three-ball chain ends at (-0.331, 0.665, 0.665), keeping 99.5 % of
+its energy; the sphere on a wall rebounds at 0.64 of its approach where e = 0.8, and slides with
+mu^2; the rocking block (e = 0, mu = 0.5, which sticks in Moreau's law) slides with mu^2 = 0.25
+and lands on one corner point, 34 % off.
 """
 
 from __future__ import annotations
@@ -139,6 +149,7 @@ def _client(settings: str) -> _Client:
         bullet = _bullet()
         client = bullet.connect(bullet.DIRECT)
         bullet.setGravity(0.0, 0.0, 0.0, physicsClientId=client)
+        bullet.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=client)
         if settings == "tuned":
             bullet.setPhysicsEngineParameter(physicsClientId=client, **TUNED)
         clients[settings] = _Client(client)
