@@ -77,7 +77,7 @@ def engine_columns_mujoco(problem):
     """Wn and Wt from MuJoCo's contacts at the initial pose: mj_jac at each contact point."""
     geometry = problem.geometry
     poses = geometry.poses(_base._displacement(problem, geometry))
-    scene = mujoco_law._MuJoCoScene(geometry, poses, np.zeros((len(poses), 6)), True, 1e-5)
+    scene = mujoco_law._MuJoCoScene(geometry, poses, np.zeros((len(poses), 6)), True, 1e-5, 1.0)
     model, data = scene.model, scene.data
     mujoco.mj_forward(model, data)
     # qvel of each generalized velocity: the joints' velocities are linear in the bodies'.
@@ -96,7 +96,7 @@ def engine_columns_mujoco(problem):
             jacobians.append(jacp)
         first, second = (scene.owner[int(g)] for g in contact.geom)
         force = _base.Force(second, first, np.array(contact.pos), np.zeros(3))
-        j, sign = _base._pair_of(geometry, force)
+        j, sign = _base.pair_of(geometry, force)
         relative_jacobian = sign * (jacobians[1] - jacobians[0]) @ Q
         directions = geometry.pairs[j].directions
         np.testing.assert_allclose(directions[0] @ contact.frame[:3] * sign, 1.0, atol=1e-9)
@@ -119,7 +119,7 @@ def engine_columns_pybullet(problem, step=1e-7):
     coefficients = pybullet_law._coefficients(geometry, True)
     velocities = np.zeros((len(geometry.bodies), 6))
     scene = pybullet_law._BulletScene(
-        geometry, geometry.poses(start), velocities, "tuned", 1e-4, coefficients
+        geometry, geometry.poses(start), velocities, "tuned", 1e-4, coefficients, 1.0
     )
     try:
         points = _closest(scene, problem)
@@ -157,7 +157,7 @@ def _closest(scene, problem, points=None):
         a, b = (scene.ids[geometry.index[name]] for name in (pair.a, pair.b))
         for point in pybullet.getClosestPoints(a, b, 1.0, physicsClientId=client):
             force = _base.Force(pair.a, pair.b, np.asarray(point[5]), np.zeros(3))
-            j, _ = _base._pair_of(geometry, force)
+            j, _ = _base.pair_of(geometry, force)
             frames = [
                 pybullet.getBasePositionAndOrientation(u, physicsClientId=client) for u in (a, b)
             ]

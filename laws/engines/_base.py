@@ -4,8 +4,11 @@ An engine law builds the scene's `Geometry` in its engine once per problem, plac
 (at the geometry's poses, moved apart by the problem's gaps, the closed contacts overlapping by
 `OVERLAP` of the smallest body so that the engine finds them), sets the pre-impact velocity, and
 steps with step ``dt`` until the impact is over: no contact force for `QUIET_STEPS` steps in a
-row and no contact approaching, within ``max_steps`` steps (the solve's `Budget`). Gravity and
-every force but the contacts' are off during the impact.
+row and no pair approaching, within ``max_steps`` steps (the solve's `Budget`). A pair
+approaches when the engine's own distance between its bodies shrank over the last step
+(`Scene.distances`): at the configuration the bodies have reached, not at the impact's, so that a
+soft contact that lets go while its bodies still overlap, and turn away from each other, ends
+the impact. Gravity and every force but the contacts' are off during the impact.
 
 At each step the engine reports its contact forces (`Scene.step`); each is mapped onto the
 problem's contact whose pair it joins (the nearest declared point where two bodies touch at
@@ -44,7 +47,7 @@ from lawbench.core.verdicts import Region
 QUIET_STEPS = 5
 # A step's impulse below this fraction of the impact's impulse scale counts as no force.
 QUIET = 1e-9
-# A contact approaching slower than this fraction of the fastest pre-impact approach is at rest.
+# A pair closing slower than this fraction of the fastest pre-impact approach is at rest.
 APPROACH = 1e-6
 # Closed contacts start this far into each other, relative to the smallest body: an engine finds
 # a contact once its bodies touch or overlap, and bodies placed touching are apart by rounding
@@ -132,6 +135,14 @@ class Scene(ABC):
         """
 
     @abstractmethod
+    def distances(self) -> np.ndarray:
+        """The engine's signed distance of each pair's bodies near its point (m,).
+
+        At most the scene's reach (`EngineLaw._open`): farther, a pair is not part of the
+        impact.
+        """
+
+    @abstractmethod
     def close(self) -> None:
         """Free what the engine holds."""
 
@@ -197,7 +208,9 @@ class EngineLaw(Law):
         dt = options["dt"] or self.steps[settings]
         poses = geometry.poses(_displacement(problem, geometry))
         velocities = geometry.body_velocities(problem.v)
-        scene = self._open(geometry, poses, velocities, settings, dt)
+        # Pairs farther apart than the largest gap and body cannot close within the impact.
+        reach = float(problem.gaps.max()) + max(max(b.size, default=0.0) for b in geometry.bodies)
+        scene = self._open(geometry, poses, velocities, settings, dt, reach)
         try:
             P, steps, engine_v = _step_through(scene, problem, geometry, dt)
         finally:
@@ -223,8 +236,11 @@ class EngineLaw(Law):
         velocities: np.ndarray,
         settings: str,
         dt: float,
+        reach: float,
     ) -> Scene:
         """Build the scene in the engine at ``poses``, moving at ``velocities`` (B, 6).
+
+        ``reach`` bounds the distances the scene reports (`Scene.distances`).
 
         Raises
         ------
@@ -293,23 +309,24 @@ def _step_through(
     # The impulse that stops the fastest contact alone: the scale of the impact's impulses.
     scale = float((un / np.diag(np.asarray(problem.delassus))).max()) or 1.0
     P = np.zeros((problem.m, 1 + problem.d))
-    budget, quiet, steps = current_budget(), 0, 0
+    budget, quiet, steps, distances = current_budget(), 0, 0, scene.distances()
     while True:
         budget.step("engine steps", f"{quiet} quiet steps, at t = {steps * dt:.3g} s")
         forces, velocities = scene.step()
         steps += 1
         impulse = np.zeros_like(P)
         for force in forces:
-            j, sign = _pair_of(geometry, force)
+            j, sign = pair_of(geometry, force)
             impulse[j] += sign * dt * (directions[j] @ force.force)
         P += impulse
         quiet = quiet + 1 if np.abs(impulse).max(initial=0.0) <= QUIET * scale else 0
-        v = geometry.generalized(velocities)
-        if quiet >= QUIET_STEPS and (problem.Wn.T @ v).min() >= -APPROACH * speed:
-            return P, steps, v
+        previous, distances = distances, scene.distances()
+        closing = float((previous - distances).max(initial=0.0)) / dt
+        if quiet >= QUIET_STEPS and closing <= APPROACH * speed:
+            return P, steps, geometry.generalized(velocities)
 
 
-def _pair_of(geometry: Geometry, force: Force) -> tuple[int, float]:
+def pair_of(geometry: Geometry, force: Force) -> tuple[int, float]:
     """The pair a reported force belongs to, and +1 or -1 for a force on its ``a`` or ``b``.
 
     Among the pairs of the force's two bodies, the one whose declared point is nearest.

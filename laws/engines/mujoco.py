@@ -200,8 +200,9 @@ class MuJoCo(EngineLaw):
         velocities: np.ndarray,
         settings: str,
         dt: float,
+        reach: float,
     ) -> Scene:
-        return _MuJoCoScene(geometry, poses, velocities, settings == "tuned", dt)
+        return _MuJoCoScene(geometry, poses, velocities, settings == "tuned", dt, reach)
 
 
 def _numbers(values: object) -> str:
@@ -240,8 +241,9 @@ class _MuJoCoScene(Scene):
         velocities: np.ndarray,
         tuned: bool,
         dt: float,
+        reach: float,
     ) -> None:
-        self.mujoco, self.geometry, self.dt = _mujoco(), geometry, dt
+        self.mujoco, self.geometry, self.dt, self.reach = _mujoco(), geometry, dt, reach
         # Each body's joints (none for a fixed body) and rotation at its pose.
         self.joints: list[list[tuple]] = []
         self.rotations = [rotation_matrix(quaternion) for _, quaternion in poses]
@@ -253,7 +255,10 @@ class _MuJoCoScene(Scene):
         names = [body.name for body in geometry.bodies]
         self.owner = {self.model.geom(f"g{k}").id: name for k, name in enumerate(names)}
         self.ids = [self.model.body(f"b{k}").id if j else None for k, j in enumerate(self.joints)]
+        geoms = {name: geom for geom, name in self.owner.items()}
+        self.pair_geoms = [(geoms[pair.a], geoms[pair.b]) for pair in geometry.pairs]
         self._set_velocities(velocities)
+        self.mujoco.mj_kinematics(self.model, self.data)
         self.force, self.velocity = np.zeros(6), np.zeros(6)
 
     def _model(self, poses: list[tuple[np.ndarray, tuple[float, ...]]], tuned: bool) -> str:
@@ -377,6 +382,15 @@ class _MuJoCoScene(Scene):
                 )
                 velocities[k] = np.concatenate([self.velocity[3:], self.velocity[:3]])
         return forces, velocities
+
+    def distances(self) -> np.ndarray:
+        """mj_geomDistance of each pair's geoms, at the positions the last step started from.
+
+        MuJoCo gives the smallest distance of two geoms: pairs of the same two bodies share it.
+        """
+        model, data, reach = self.model, self.data, self.reach
+        distance = self.mujoco.mj_geomDistance
+        return np.array([distance(model, data, a, b, reach, None) for a, b in self.pair_geoms])
 
     def close(self) -> None:
         """Nothing to free: the model and its data go with the scene."""

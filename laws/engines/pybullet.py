@@ -75,6 +75,7 @@ from lawbench.laws.engines._base import (
     Force,
     Scene,
     engine_options,
+    pair_of,
     quietly,
     require,
 )
@@ -104,6 +105,7 @@ TUNED = {
 CORNER_RADIUS = 1e-3
 # Bullet clamps the product of two frictions to this.
 MAX_FRICTION = 10.0
+_NO_FORCE = np.zeros(3)
 # The arguments of createCollisionShape for each shape Bullet has, from the geometry's sizes.
 SIZES = {
     "sphere": lambda size: {"radius": size[0]},
@@ -237,9 +239,10 @@ class PyBullet(EngineLaw):
         velocities: np.ndarray,
         settings: str,
         dt: float,
+        reach: float,
     ) -> Scene:
         coefficients = _coefficients(geometry, settings == "tuned")
-        return _BulletScene(geometry, poses, velocities, settings, dt, coefficients)
+        return _BulletScene(geometry, poses, velocities, settings, dt, coefficients, reach)
 
 
 def _coefficients(geometry: Geometry, tuned: bool) -> list[tuple[float, float]]:
@@ -331,8 +334,9 @@ class _BulletScene(Scene):
         settings: str,
         dt: float,
         coefficients: list[tuple[float, float]],
+        reach: float,
     ) -> None:
-        self.bullet, self.geometry = _bullet(), geometry
+        self.bullet, self.geometry, self.reach = _bullet(), geometry, reach
         self.client = _client(settings)
         # The scene's bodies in the geometry's order, and those it made (the others are planes
         # the client keeps).
@@ -476,6 +480,16 @@ class _BulletScene(Scene):
             [np.concatenate(self._call("getBaseVelocity", uid)) for uid in self.ids]
         )
         return forces, velocities
+
+    def distances(self) -> np.ndarray:
+        """Bullet's closest points of each two bodies that touch, each to its nearest pair."""
+        geometry, found = self.geometry, np.full(len(self.geometry.pairs), self.reach)
+        for first, second in {(p.a, p.b) for p in geometry.pairs}:
+            a, b = self.ids[geometry.index[first]], self.ids[geometry.index[second]]
+            for point in self._call("getClosestPoints", a, b, self.reach):
+                j, _ = pair_of(geometry, Force(first, second, np.asarray(point[5]), _NO_FORCE))
+                found[j] = min(found[j], point[8])
+        return found
 
     def close(self) -> None:
         """Remove the bodies the scene made from the client, for the next solve."""
