@@ -239,6 +239,8 @@ class TwoContactChain(Case):
     """
 
     pairs: ClassVar[tuple[Pair, Pair]]
+    # The balls' radius in the geometry an engine builds (m).
+    radius: ClassVar[float] = BALL_RADIUS
 
     @staticmethod
     def specs(velocities: list[float], velocities_doc: str, ratio_doc: str) -> tuple[Spec, ...]:
@@ -268,7 +270,7 @@ class TwoContactChain(Case):
             stiffness=[1.0, params["stiffness_ratio"]],
             exponents=[params["exponent"]] * 2,
             gaps=params["gaps"],
-            radius=BALL_RADIUS,
+            radius=self.radius,
         )
 
 
