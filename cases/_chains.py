@@ -4,7 +4,9 @@ Coordinates are the ball velocities along the line. A contact is a pair ``(left,
 ball indices, the right ball being on the positive side of the left one, so the gap rate is
 ``v[right] - v[left]``; ``None`` in place of a ball is a fixed wall.
 
-This module builds the problems of every chain scene and the specs of their parameters, and
+This module builds the problems of every chain scene, with the geometry an engine builds of
+them (`chain_geometry`: balls on free joints along x, walls as fixed planes), and the specs of
+their parameters, and
 holds the references of free chains, the ground truth of every chain scene (compliant
 integration at the scene's stiffnesses) and the studies the chain scenes declare alike (as
 data, `lawbench.studies.declared`), each run with every contact elastic and with every contact
@@ -13,13 +15,16 @@ plastic.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
 
+from lawbench.cases._geometry import geometry, plane, solid_sphere
 from lawbench.checks.knobs import decades
 from lawbench.core.case import Case, GroundTruth, Reference, exactly, per_item
+from lawbench.core.geometry import ContactPair, Geometry, Joint
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
 
@@ -27,6 +32,12 @@ Pair = tuple[int | None, int | None]
 # Beyond this many contacts a chain's M and Wn are scipy.sparse: dense n x n storage and
 # products would dominate its cost, and Moreau's law solves it sparse end to end.
 SPARSE_CONTACTS = 256
+# The longest chain that declares its geometry: an engine steps every ball, and the velocity
+# map is dense (6 n x n).
+GEOMETRY_BALLS = 64
+# The radius of the balls of a chain scene that states none (m): the rigid laws' outcome does
+# not depend on it.
+BALL_RADIUS = 0.1
 
 
 def chain_problem(
@@ -37,6 +48,7 @@ def chain_problem(
     stiffness: Sequence[float],
     exponents: Sequence[float],
     gaps: Sequence[float] | None = None,
+    radius: float | None = None,
 ) -> ImpactProblem:
     """Return the impact problem of balls on a line touching along ``pairs``.
 
@@ -50,6 +62,9 @@ def chain_problem(
         Restitution coefficient, stiffness and force-indentation exponent of each contact.
     gaps : sequence of m floats, optional
         Initial gaps (m); zero by default.
+    radius : float, optional
+        The balls' radius (m) in the geometry an engine builds (`chain_geometry`); None
+        declares no geometry.
     """
     M, Wn = _mass_and_normals(np.asarray(masses, dtype=float), pairs)
     springs = list(zip(restitution, stiffness, exponents, strict=True))
@@ -66,7 +81,67 @@ def chain_problem(
         contacts=contacts,
         bodies={f"ball {i + 1}": (i,) for i in range(len(masses))},
         gaps=None if gaps is None else np.asarray(gaps, dtype=float),
+        geometry=None
+        if radius is None or len(masses) > GEOMETRY_BALLS
+        else chain_geometry(tuple(masses), tuple(pairs), tuple(restitution), radius),
     )
+
+
+@functools.lru_cache(maxsize=64)
+def chain_geometry(
+    masses: tuple[float, ...],
+    pairs: tuple[Pair, ...],
+    restitution: tuple[float, ...],
+    radius: float,
+) -> Geometry | None:
+    """Balls of ``radius`` touching along the x axis, on free joints, walls as fixed planes.
+
+    The right ball of a pair lies ``2 radius`` to the right of its left ball; a wall is the
+    plane tangent to its ball, its normal towards the ball. Generalized velocity i is ball i's
+    velocity along x: the contacts are head-on, so the balls keep to the line. None when the
+    pairs do not place every ball once on a line. Cached: a geometry is immutable, and the
+    scenes build the same chain again and again.
+    """
+    x = _places(len(masses), pairs, 2 * radius)
+    if x is None:
+        return None
+    balls = [
+        solid_sphere(f"ball {i + 1}", mass, radius, (x[i], 0.0, 0.0))
+        for i, mass in enumerate(masses)
+    ]
+    walls, contacts = [], []
+    for j, ((left, right), e) in enumerate(zip(pairs, restitution, strict=True)):
+        if left is not None and right is not None:
+            a, b, point, normal = balls[right], balls[left], x[left] + radius, 1.0
+        else:
+            a = balls[right if left is None else left]
+            normal = 1.0 if left is None else -1.0
+            point = a.position[0] - normal * radius
+            walls.append(plane(f"wall {j}", (point, 0.0, 0.0), (normal, 0.0, 0.0)))
+            b = walls[-1]
+        contacts.append(ContactPair(a.name, b.name, (point, 0.0, 0.0), (normal, 0.0, 0.0), e=e))
+    joints = [Joint("free", ball.name) for ball in balls] + [Joint("fixed", w.name) for w in walls]
+    return geometry([*balls, *walls], joints, contacts, [(i, 0) for i in range(len(balls))])
+
+
+def _places(balls: int, pairs: Sequence[Pair], spacing: float) -> list[float] | None:
+    """The balls' centres along x, ball 0 at 0, each pair's right ball ``spacing`` further.
+
+    None when the pairs leave a ball unplaced or place one twice at different points.
+    """
+    x: dict[int, float] = {0: 0.0}
+    between = [(left, right) for left, right in pairs if left is not None and right is not None]
+    for _ in range(balls):
+        for left, right in between:
+            if left in x and right not in x:
+                x[right] = x[left] + spacing
+            elif right in x and left not in x:
+                x[left] = x[right] - spacing
+    if len(x) < balls:
+        return None
+    if any(abs(x[right] - x[left] - spacing) > 1e-9 * spacing for left, right in between):
+        return None
+    return [x[i] for i in range(balls)]
 
 
 def _mass_and_normals(masses: np.ndarray, pairs: Sequence[Pair]) -> tuple[Any, Any]:
@@ -164,6 +239,8 @@ class TwoContactChain(Case):
     """
 
     pairs: ClassVar[tuple[Pair, Pair]]
+    # The balls' radius in the geometry an engine builds (m).
+    radius: ClassVar[float] = BALL_RADIUS
 
     @staticmethod
     def specs(velocities: list[float], velocities_doc: str, ratio_doc: str) -> tuple[Spec, ...]:
@@ -193,6 +270,7 @@ class TwoContactChain(Case):
             stiffness=[1.0, params["stiffness_ratio"]],
             exponents=[params["exponent"]] * 2,
             gaps=params["gaps"],
+            radius=self.radius,
         )
 
 

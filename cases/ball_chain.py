@@ -6,8 +6,9 @@ the right). Contact i (0-based) is between balls i+1 and i+2, gap rate ``v[i+1] 
 ``-vn``. ``stiffness`` and ``exponent`` are one value for every contact or one per contact
 (default 1 N/m^1.5, Hertz). ``velocities`` gives the first balls; the
 ones it leaves out are at rest, so the default is one ball striking a chain at rest (the
-Newton's cradle of the textbooks). Source: Brogliato, *An introduction to impact dynamics*
-(2010), chains of balls.
+Newton's cradle of the textbooks). Geometry, for the engines, up to 64 balls: balls of radius
+0.1 m touching along x, the wall a plane (`_chains.chain_geometry`). Source: Brogliato, *An
+introduction to impact dynamics* (2010), chains of balls.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._chains import (
+    BALL_RADIUS,
     ELASTIC_AND_PLASTIC,
     NEWTONS_CRADLE,
     PLASTIC_CHAIN,
@@ -95,6 +97,7 @@ class BallChain(Case):
             stiffness=params["stiffness"],
             exponents=params["exponent"],
             gaps=params["gaps"],
+            radius=BALL_RADIUS,
         )
 
     def coordinates(self, params: Params) -> list[str]:

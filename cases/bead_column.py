@@ -9,7 +9,8 @@ itself and the wall at the first instant; gravity is ignored during the impact.
 Parameters: ``n`` beads (1 to 1000, default 10), ``drop_height`` (m, default 3.1e-3),
 ``e`` (one value or one per contact, default 1). Fixed by the experiment: stainless steel
 beads 8 mm in diameter of 2.05e-3 kg, Hertz contacts (exponent 3/2) of stiffness 6.9716e9
-N/m^1.5 between beads and 9.858e9 N/m^1.5 against the wall.
+N/m^1.5 between beads and 9.858e9 N/m^1.5 against the wall. Geometry, for the engines, up to 64
+beads: beads of radius 4 mm along the wall's normal (`_chains.chain_geometry`).
 
 Source: E. Falcon, C. Laroche, S. Fauve, C. Coste, Eur. Phys. J. B 5 (1998), as reported in
 Brogliato, *An introduction to impact dynamics* (2010), 'Columns of balls impacting a wall':
@@ -31,6 +32,7 @@ from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 
 BEAD_MASS = 2.05e-3
+BEAD_RADIUS = 4e-3
 BEAD_STIFFNESS = 6.9716e9
 WALL_STIFFNESS = 9.858e9
 GRAVITY = 9.81
@@ -66,6 +68,7 @@ class BeadColumn(Case):
             restitution=params["e"],
             stiffness=[WALL_STIFFNESS] + [BEAD_STIFFNESS] * (n - 1),
             exponents=[1.5] * n,
+            radius=BEAD_RADIUS,
         )
 
     def coordinates(self, params: Params) -> list[str]:

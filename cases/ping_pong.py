@@ -5,7 +5,8 @@ ball 2 meets the table. Generalized coordinates: the vertical velocities v1 (upp
 (lower ball), m/s, positive up (away from the table). Contact 0 is between the balls (gap rate
 ``v1 - v2``), contact 1 between ball 2 and the table (gap rate ``v2``). Gravity is ignored
 during the impact. Contact 0 has stiffness 1 N/m^exponent and the table contact
-``stiffness_ratio`` = k2/k1 times that; the outcome depends on the ratio only.
+``stiffness_ratio`` = k2/k1 times that; the outcome depends on the ratio only. Geometry, for the
+engines: 40 mm balls, stacked on the table plane (`_chains.chain_geometry`).
 
 Parameters (``lawbench describe ping_pong``): ``masses`` (kg, default 2.7 g each: a regulation
 40 mm table-tennis ball), ``velocities`` (m/s, default both -1: dropped together, hitting the
@@ -63,6 +64,7 @@ MEASURED_E = [0.950043, 0.846529]
 GUESSED_RATIO = 3.0
 # A regulation 40 mm table-tennis ball (ITTF: 2.7 g).
 BALL_MASS = 2.7e-3
+BALL_RADIUS = 0.02
 
 
 class PingPong(TwoBallsWall):
@@ -74,6 +76,7 @@ class PingPong(TwoBallsWall):
 
     name = "ping_pong"
     summary = "two table-tennis balls stacked and dropped on a table (Jia, Mason, Erdmann 2013)"
+    radius = BALL_RADIUS
     params = (
         masses_spec([BALL_MASS, BALL_MASS]),
         velocities_spec([-1.0, -1.0], "pre-impact velocities of ball 1 (upper) and ball 2, up"),

@@ -9,7 +9,9 @@ block rotates about its right bottom corner, the pivot, with angular velocity ``
 gap rate ``vy - omega width / 2`` (``-omega width`` before the impact); contact 1 is the right
 corner, the pivot, gap rate ``vy + omega width / 2`` (zero before). Both have the floor's normal
 ``(0, 1)`` and the tangent ``(1, 0)``, and the same ``e`` and ``mu``. The moment of inertia
-about the centre of mass is ``mass (width^2 + height^2) / 12``.
+about the centre of mass is ``mass (width^2 + height^2) / 12``. Geometry, for the engines: a
+box as deep as it is wide on a planar joint (the x-y plane), on the fixed floor plane ``y = 0``,
+the contacts at the middles of its bottom edges.
 
 Parameters (defaults): ``width`` 0.5 m, ``height`` 1 m, ``mass`` 10 kg, ``omega`` 1 rad/s,
 ``e`` 0 (Newton's coefficient of both corners: Housner's plastic impact), ``mu`` 0.5.
@@ -40,13 +42,16 @@ is then >= 0).
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
 import numpy as np
 
 from lawbench.cases import _specs
+from lawbench.cases._geometry import geometry, plane, solid_box
 from lawbench.core.case import CASES, Case, GroundTruth, Params, Reference
+from lawbench.core.geometry import ContactPair, Geometry, Joint
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.tags import Tags
 from lawbench.core.trial import Trial
@@ -111,6 +116,25 @@ def _one_contact_holds(p: Params) -> str | None:
     if p["height"] < math.sqrt(2) * p["width"]:
         return "needs height >= sqrt(2) width: otherwise the pivot is pushed into the floor"
     return None
+
+
+@functools.lru_cache(maxsize=64)
+def _geometry(width: float, height: float, mass: float, e: float, mu: float) -> Geometry:
+    """The block as a box on a planar joint in the x-y plane, on the floor plane y = 0.
+
+    The box is as deep (along z) as it is wide; its bottom corners touch the floor along the
+    lines ``x = -+width/2``, and the contact points are their middles, in the plane of motion.
+    Cached: a geometry is immutable, and a sweep of omega keeps it.
+    """
+    block = solid_box("block", mass, (width / 2, height / 2, width / 2), (0, height / 2, 0))
+    floor = plane("floor", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    x, y = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
+    pairs = [
+        ContactPair("block", "floor", (corner, 0.0, 0.0), y, (x,), e, mu)
+        for corner in (-width / 2, width / 2)
+    ]
+    joints = [Joint("planar", "block", (0.0, 0.0, 1.0)), Joint("fixed", "floor")]
+    return geometry([block, floor], joints, pairs, [(0, 0), (0, 1), (0, 5)])
 
 
 class RockingBlock(Case):
@@ -189,6 +213,7 @@ class RockingBlock(Case):
             v=pre_impact_velocity(params),
             contacts=[contact, contact],
             bodies={"block": (0, 1, 2)},
+            geometry=_geometry(width, height, mass, params["e"], params["mu"]),
         )
 
     def coordinates(self, params: Params) -> list[str]:

@@ -7,7 +7,9 @@ centre. Its tangents are ``t1 = (1, 0, 0)`` (in the plane of incidence) and
 ``t2 = (0, 0, 1)``. Before the impact the centre moves in the ``x-y`` plane at ``speed`` and
 ``angle`` from the wall normal: ``v- = speed (sin(angle), -cos(angle), 0)``; the contact point
 slips at ``ut- = (vx + radius wz, vz - radius wx)`` along ``(t1, t2)``. The spin about the
-normal (``wy``) does not move the contact point. ``I = 2 mass radius^2 / 5``.
+normal (``wy``) does not move the contact point. ``I = 2 mass radius^2 / 5``. Geometry, for
+the engines: the sphere on a free joint, centred at ``radius n``, touching the fixed plane
+``y = 0`` at the origin.
 
 Parameters (defaults): ``radius`` 0.1 m, ``mass`` 1 kg, ``angle`` 45 degrees, ``speed``
 2 m/s, ``spin`` (5, 2, -10) rad/s (the contact point slips at (0.414, -0.5) m/s, out of the
@@ -25,6 +27,7 @@ and tangential mass ``2 mass / 7`` (``1 / m_t = 1 / mass + radius^2 / I``), no c
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -32,7 +35,9 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
+from lawbench.cases._geometry import geometry, plane, solid_sphere
 from lawbench.core.case import CASES, Case, Params, Reference, exactly
+from lawbench.core.geometry import ContactPair, Geometry, Joint
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
@@ -64,6 +69,20 @@ def _equation_11(p: Params) -> np.ndarray:
     inertia = 2 * m * radius**2 / 5
     torque = np.cross(-radius * NORMAL, impulse)
     return np.concatenate([velocity + impulse / m, spin + torque / inertia])
+
+
+@functools.lru_cache(maxsize=64)
+def _geometry(mass: float, radius: float, e: float, mu: float) -> Geometry:
+    """The sphere touching the plane y = 0 at the origin, on a free joint.
+
+    Cached: a geometry is immutable, and a sweep of the angle, speed or spin keeps it.
+    """
+    sphere = solid_sphere("sphere", mass, radius, radius * NORMAL)
+    wall = plane("wall", (0.0, 0.0, 0.0), NORMAL)
+    tangents = tuple(map(tuple, TANGENTS))
+    contact = ContactPair("sphere", "wall", (0.0, 0.0, 0.0), tuple(NORMAL), tangents, e, mu)
+    joints = [Joint("free", "sphere"), Joint("fixed", "wall")]
+    return geometry([sphere, wall], joints, [contact], [(0, k) for k in range(6)])
 
 
 class SphereWall(Case):
@@ -133,6 +152,7 @@ class SphereWall(Case):
             v=pre_impact_velocity(params),
             contacts=[contact],
             bodies={"sphere": tuple(range(6))},
+            geometry=_geometry(m, radius, params["e"], params["mu"]),
         )
 
     def coordinates(self, params: Params) -> list[str]:

@@ -3,7 +3,8 @@
 Generalized coordinates: the velocities v1, v2, v3 of balls 1, 2, 3 (left to right, m/s,
 positive to the right). Contact 0 is between balls 1 and 2, contact 1 between balls 2 and 3;
 gap rates are ``v2 - v1`` and ``v3 - v2``. Contact 0 has stiffness 1 N/m^exponent and contact 1
-``stiffness_ratio`` times that (only compliant and energetic laws read stiffness). Source:
+``stiffness_ratio`` times that (only compliant and energetic laws read stiffness). Geometry,
+for the engines: balls of radius 0.1 m touching along x (`_chains.chain_geometry`). Source:
 Brogliato, *An introduction to impact dynamics* (2010), three-ball chain, equation (29).
 """
 

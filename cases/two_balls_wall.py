@@ -4,9 +4,10 @@ Generalized coordinates: the velocities v1 (ball 1, the outer one) and v2 (ball 
 the wall) along the wall normal, m/s, positive away from the wall. Contact 0 is between the
 balls (gap rate ``v1 - v2``), contact 1 between ball 2 and the wall (gap rate ``v2``). Gravity
 is ignored during the impact. Contact 0 has stiffness 1 N/m^exponent, the wall contact
-``stiffness_ratio`` times that. Source: Brogliato, *An introduction to impact dynamics* (2010),
-equations (25)-(28); the kinetic angle of the two constraints (26) is obtuse, so sequences of
-binary impacts depend on their order.
+``stiffness_ratio`` times that. Geometry, for the engines: balls of radius 0.1 m along x on the
+wall plane (`_chains.chain_geometry`). Source: Brogliato, *An introduction to impact dynamics*
+(2010), equations (25)-(28); the kinetic angle of the two constraints (26) is obtuse, so
+sequences of binary impacts depend on their order.
 """
 
 from __future__ import annotations

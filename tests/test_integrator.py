@@ -131,7 +131,7 @@ def test_every_law_has_a_time_budget():
 
 
 # A scene on which each law with a step budget steps: integrator steps, fixed-point steps of
-# Coulomb's law, binary impacts.
+# Coulomb's law, binary impacts, an engine's steps.
 STEPPING = {
     "compliant": ("three_ball_chain", {}, {}),
     "lzb": ("three_ball_chain", {}, {}),
@@ -139,6 +139,8 @@ STEPPING = {
     "darboux_keller": None,
     "moreau": ("lamina", {}, {"friction": "coulomb", "method": "fixed_point"}),
     "sequential": ("two_balls_wall", {"e": 0.0}, {}),
+    "mujoco": ("three_ball_chain", {}, {}),
+    "pybullet": ("three_ball_chain", {}, {}),
 }
 
 

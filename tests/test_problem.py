@@ -54,7 +54,10 @@ def test_problem_arrays_are_read_only_and_laws_do_not_mutate():
         problem.v[0] = 3.0
     before = problem.v.copy()
     for law in lawbench.LAWS.values():
-        law.resolve(problem)
+        try:
+            law.resolve(problem)
+        except lawbench.NotApplicable:
+            continue  # an engine law refuses a problem whose scene declares no geometry
     assert np.array_equal(problem.v, before)
 
 

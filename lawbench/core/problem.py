@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.geometry import Geometry
 from lawbench.core.metric import (
     SMALL,
     KineticMetric,
@@ -238,6 +239,9 @@ class ImpactProblem:
     gaps : array (m,) or None
         Initial gaps; None means zero (a simultaneous impact). A contact with a positive gap is
         open: the rigid laws leave it alone at this instant.
+    geometry : Geometry or None
+        What the scene looks like, for the engine laws that build it (`lawbench.core.geometry`);
+        None when the scene declares none. The other laws and the checks never read it.
 
     Attributes
     ----------
@@ -269,6 +273,7 @@ class ImpactProblem:
     Wt: np.ndarray | None = None
     bodies: Mapping[str, Sequence[int]] = field(default_factory=dict)
     gaps: np.ndarray | None = None
+    geometry: Geometry | None = field(default=None, repr=False)
     # Found while the fields are checked, and stored then by `__init__`.
     n: int = field(init=False, repr=False)
     m: int = field(init=False, repr=False)
@@ -286,6 +291,7 @@ class ImpactProblem:
         Wt: Any = None,
         bodies: Mapping[str, Sequence[int]] | None = None,
         gaps: Any = None,
+        geometry: Geometry | None = None,
     ) -> None:
         # Every field is checked here and the problem keeps its own read-only copies, written
         # once into the instance (the dataclass is frozen).
@@ -329,6 +335,9 @@ class ImpactProblem:
         else:
             state["gaps"] = _gaps(gaps, m)
         state["bodies"] = _bodies(bodies, n)
+        if geometry is not None and not isinstance(geometry, Geometry):
+            raise InvalidProblem(f"geometry is {type(geometry).__name__}, not Geometry")
+        state["geometry"] = geometry
         state["metric"] = KineticMetric(self.M)
         self._check_normals()
         T_minus = kinetic_energy(self.M, self.v)

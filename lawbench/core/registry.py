@@ -83,6 +83,14 @@ class Registry(Mapping[str, Entry]):
         self._entries[entry.name] = entry
         return entry
 
+    def missing(self, name: str, reason: str) -> None:
+        """Record that the entry ``name`` did not load, and why.
+
+        For a module that registers several entries, each with a dependency of its own: the
+        others load, and ``name`` is listed in `unavailable` like a module that failed.
+        """
+        self.unavailable[name] = reason
+
     def _load(self) -> None:
         if self._loaded:
             return

@@ -1,0 +1,501 @@
+"""PyBullet (Bullet Physics) as an impact law: the scene built in Bullet and stepped through.
+
+Source: Bullet Physics through PyBullet 3.2 (E. Coumans and Y. Bai, PyBullet Quickstart Guide,
+https://docs.google.com/document/d/10sXEhzFRSnvFcl3XxNGhnD4N2SedqwdAvK3dsihxVUA: stepSimulation,
+changeDynamics, setPhysicsEngineParameter, getContactPoints); the solver is Bullet's sequential
+impulse method (projected Gauss-Seidel on the contact impulses of each step,
+btSequentialImpulseConstraintSolver), and each contact's coefficients are those of its two
+bodies combined (btManifoldResult.cpp: calculateCombinedRestitution and
+calculateCombinedFriction, the products of the bodies' coefficients, friction clamped to 10).
+
+Conventions: the common stepping rule of the engine laws (`lawbench.laws.engines._base`);
+Bullet's positions and velocities are the bodies' centres of mass and its angular velocities
+are in the world frame, as the geometry's. A contact point reports the forces of the step just
+taken (getContactPoints): normalForce along contactNormalOnB (from B to A) and lateralFriction1
+and 2 along lateralFrictionDir1 and 2, together the force on A; a step's impulse is that force
+times the step. Gravity and Bullet's velocity damping (linearDamping, angularDamping, 0.04 by
+default) are off: they act in flight, not in the impact. Solves share a client per thread and
+setting (a client takes 50 ms to connect), which sorts its overlapping pairs
+(deterministicOverlappingPairs) so that the solver meets the contacts in the same order whatever
+the client solved before. Joints: a free joint is a Bullet base with mass, a fixed one a base
+without; Bullet has no planar joint, so a planar body is a free one whose contact forces lie in
+its plane of motion (the rocking block's contact points lie in the plane through its centre of
+mass, so its motion stays planar); hinges and slides are not built.
+
+Settings (option ``settings``):
+
+- ``default``, what a user gets: Bullet's defaults (setPhysicsEngineParameter untouched but the
+  step, 1/240 s, the documented default, and the order of the pairs), and each body given the
+  scene's coefficients as the Quickstart describes them, a property of the body (changeDynamics'
+  restitution and lateralFriction; a body in contacts of different coefficients takes their
+  mean). Bullet then
+  multiplies the two bodies' coefficients: a contact of restitution e and friction mu acts with
+  e^2 and mu^2. Bullet's box-plane contact manifold gains one point per step, so a box lands on
+  one corner point first.
+- ``tuned``, as rigid and faithful to e and mu as Bullet allows: contactSlop 0 (the slop lets a
+  closed contact approach at slop/dt, swallowing the restitution as the step shrinks), erp,
+  contactERP and frictionERP 0 (the error reduction pushes penetrating bodies apart with
+  velocity, which creates energy), restitutionVelocityThreshold 0 (restitution at every
+  speed), 1000 solver iterations with solverResidualThreshold 0 (the solver stops at neither),
+  a step of 1e-4 s, and per-body coefficients whose products are the scene's (where a fixed body
+  takes part, it keeps 1 and the moving body the scene's value); a box touches through small
+  spheres (radius `CORNER_RADIUS` of its smallest half-extent) at its declared contact points.
+  Bullet's restitution is then Moreau's per-contact rule on each step's velocities,
+  ``0 <= un+ + e un- _|_ Pn >= 0``, with Coulomb's friction on the impulses in its circular
+  cone (enableConeFriction, on by default; off, a pyramid lets |Pt| reach sqrt(2) mu Pn).
+
+Measured against Moreau's law, relative to the largest pre-impact velocity: tuned, 1e-15 on the
+chains, the sphere on a wall (with and without spin, sticking or sliding) and the rocking block.
+At the defaults the elastic three-ball chain ends at (-0.331, 0.665, 0.665), keeping 99.5 % of
+its energy; the sphere on a wall rebounds at 0.64 of its approach where e = 0.8, and slides with
+mu^2; the rocking block (e = 0, mu = 0.5, which sticks in Moreau's law) slides with mu^2 = 0.25
+and lands on one corner point, 34 % off.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from lawbench.checks.regions import oblique_contacts, option, separating_contact
+from lawbench.core.errors import NotApplicable
+from lawbench.core.geometry import Body, Geometry
+from lawbench.core.law import LAWS
+from lawbench.core.verdicts import Claim
+from lawbench.laws._claims import RIGID_DISPERSION
+from lawbench.laws.engines._base import (
+    EngineLaw,
+    Force,
+    Scene,
+    engine_options,
+    pair_of,
+    quietly,
+    require,
+)
+
+require("pybullet")
+
+_QUICKSTART = (
+    "PyBullet Quickstart Guide (Coumans and Bai), "
+    "https://docs.google.com/document/d/10sXEhzFRSnvFcl3XxNGhnD4N2SedqwdAvK3dsihxVUA"
+)
+_SOLVER = "Bullet's btSequentialImpulseConstraintSolver (https://github.com/bulletphysics/bullet3)"
+_COMBINED = (
+    "Bullet's btManifoldResult.cpp, calculateCombinedRestitution and calculateCombinedFriction "
+    "(https://github.com/bulletphysics/bullet3)"
+)
+# The tuned engine parameters (setPhysicsEngineParameter).
+TUNED = {
+    "contactSlop": 0.0,
+    "erp": 0.0,
+    "contactERP": 0.0,
+    "frictionERP": 0.0,
+    "restitutionVelocityThreshold": 0.0,
+    "numSolverIterations": 1000,
+    "solverResidualThreshold": 0.0,
+}
+# The radius of the spheres a tuned box touches through, over its smallest half-extent.
+CORNER_RADIUS = 1e-3
+# Bullet clamps the product of two frictions to this.
+MAX_FRICTION = 10.0
+_NO_FORCE = np.zeros(3)
+# The arguments of createCollisionShape for each shape Bullet has, from the geometry's sizes.
+SIZES = {
+    "sphere": lambda size: {"radius": size[0]},
+    "box": lambda size: {"halfExtents": list(size)},
+    "capsule": lambda size: {"radius": size[0], "height": 2 * size[1]},
+    "cylinder": lambda size: {"radius": size[0], "height": 2 * size[1]},
+    "plane": lambda size: {},
+}
+
+
+@functools.cache
+def _bullet() -> ModuleType:
+    """The pybullet module, imported on first use (it writes its build time to stderr)."""
+    return quietly("pybullet")
+
+
+# Each thread's PyBullet clients, one per setting: connecting a client costs some 50 ms, a
+# thousand times a step, so a solve borrows its setting's client and leaves it as it found it.
+_CLIENTS = threading.local()
+
+
+@dataclass
+class _Client:
+    """A PyBullet client (DIRECT mode: in process, no window) and what solves leave in it.
+
+    PyBullet keeps a collision shape once a body used it (removeCollisionShape refuses), so the
+    shapes are kept by their description and used again; a plane body takes some 10 ms to make,
+    so the planes stay too, moved where the next scene wants them.
+    """
+
+    id: int
+    shapes: dict[tuple, int] = field(default_factory=dict)
+    planes: list[int] = field(default_factory=list)
+
+
+def _client(settings: str) -> _Client:
+    """The PyBullet client of ``settings`` in this thread.
+
+    Made on first use, with gravity off and, tuned, the `TUNED` parameters set.
+    """
+    clients = _CLIENTS.__dict__
+    if settings not in clients:
+        bullet = _bullet()
+        client = bullet.connect(bullet.DIRECT)
+        bullet.setGravity(0.0, 0.0, 0.0, physicsClientId=client)
+        bullet.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=client)
+        if settings == "tuned":
+            bullet.setPhysicsEngineParameter(physicsClientId=client, **TUNED)
+        clients[settings] = _Client(client)
+    return clients[settings]
+
+
+class PyBullet(EngineLaw):
+    """Bullet Physics through PyBullet: the scene stepped with Bullet's impulse solver."""
+
+    name = "pybullet"
+    summary = (
+        "PyBullet (Bullet Physics): the scene's bodies stepped through the impact with Bullet's "
+        "sequential-impulse solver, at its defaults or tuned"
+    )
+    source = f"Bullet Physics / PyBullet 3.2: {_QUICKSTART}; {_COMBINED}"
+    steps = {"default": 1.0 / 240.0, "tuned": 1e-4}
+    settings_words = {
+        "default": "PyBullet at its defaults (coefficients multiplied)",
+        "tuned": "PyBullet tuned (no slop, no error reduction, coefficients as given)",
+    }
+    separating_rule = (
+        "Bullet's own: a closed contact that separates takes an impulse only where its "
+        "neighbours' push makes it approach during a step"
+    )
+    options = engine_options(
+        steps,
+        "Bullet's defaults, step 1/240 s, each body given its contacts' e and mu (Bullet "
+        "multiplies the two bodies')",
+        "contactSlop, erp, contactERP, frictionERP and restitutionVelocityThreshold 0, 1000 "
+        "solver iterations, step 1e-4 s, per-body coefficients whose products are the scene's, "
+        "boxes touching through small spheres at their contact points",
+    )
+    findings = (
+        RIGID_DISPERSION,
+        Claim(
+            "continuity",
+            oblique_contacts,
+            f"Paoli 2005; Brogliato 2010, kinetic angle and continuity; {_QUICKSTART}",
+            "each step solves its contacts as impulses on the velocities, a rigid law: where a "
+            "gap closes within the impact the contacts are met one after the other, and the two "
+            "closing orders disagree at a kinetic angle other than 90 degrees (tuned, the "
+            "three-ball chain goes from Moreau's (-1/3, 2/3, 2/3) to Newton's cradle (0, 0, 1) "
+            "when contact 1 starts 1e-6 m open)",
+            (("three_ball_chain", "default"),),
+        ),
+        *(
+            Claim(
+                check,
+                separating_contact,
+                f"Brogliato 2010, Moreau's law; {_SOLVER}",
+                "Bullet restitutes each contact on its own from the velocities before the step, "
+                "0 <= un+ + e un- _|_ Pn >= 0 with no restitution on a separating contact: "
+                "Moreau's unilateral law, which gains Pn un- / 2 where a contact that separates "
+                "is pushed back by its neighbours (+8 % on the three-ball chain)",
+                (("three_ball_chain", "separating contact"),),
+            )
+            for check in ("energy_gain", "energy_kept")
+        ),
+        Claim(
+            "energy_kept",
+            option("settings", "default"),
+            f"{_QUICKSTART}: contactSlop, erp, contactERP",
+            "at its defaults Bullet lets a closed contact approach by its contact slop within a "
+            "step and pushes overlapping bodies apart by its error reduction, so an elastic "
+            "impact does not keep its energy: the three-ball chain keeps 99.5 % at 1/240 s, 81 % "
+            "at 1e-4 s and a third (the plastic outcome) at 1e-5 s; the elastic rocking block "
+            "keeps 88 %, its box landing on one point of its contact manifold, off its plane",
+            (("three_ball_chain", "default"),),
+        ),
+    )
+    guarantees = (
+        Claim(
+            "energy_kept",
+            option("settings", "tuned") & ~separating_contact,
+            f"Brogliato 2010, Moreau's law; {_SOLVER}",
+            "tuned, each step restitutes every approaching contact at un+ = -un- and holds the "
+            "others at un+ >= 0, as Moreau's law does, which keeps the energy at e = 1",
+        ),
+    )
+
+    def _open(
+        self,
+        geometry: Geometry,
+        poses: list[tuple[np.ndarray, tuple[float, ...]]],
+        velocities: np.ndarray,
+        settings: str,
+        dt: float,
+        reach: float,
+    ) -> Scene:
+        coefficients = _coefficients(geometry, settings == "tuned")
+        return _BulletScene(geometry, poses, velocities, settings, dt, coefficients, reach)
+
+
+def _coefficients(geometry: Geometry, tuned: bool) -> list[tuple[float, float]]:
+    """Each body's restitution and lateral friction (changeDynamics).
+
+    Default: the mean of the scene's coefficients over the body's pairs, as a user gives a body
+    its coefficients. Tuned: factors whose products over each pair's bodies are the pair's
+    coefficients (`_factors`).
+
+    Raises
+    ------
+    NotApplicable
+        When no such factors exist (tuned).
+    """
+    count = len(geometry.bodies)
+    columns = []
+    for kind in ("e", "mu"):
+        values = [getattr(pair, kind) for pair in geometry.pairs]
+        if not tuned:
+            columns.append(_means(geometry, values))
+            continue
+        factors = _factors(geometry, values)
+        if factors is None or (kind == "mu" and max(values) > MAX_FRICTION):
+            raise NotApplicable(
+                f"pybullet: Bullet gives a contact the product of its two bodies' {kind}; no "
+                f"per-body values have the scene's {kind} = {values} as their products"
+            )
+        columns.append(factors)
+    return [(columns[0][k], columns[1][k]) for k in range(count)]
+
+
+def _means(geometry: Geometry, values: Sequence[float]) -> list[float]:
+    """Each body's mean of ``values`` over the pairs it takes part in (0 for none)."""
+    sums, counts = np.zeros(len(geometry.bodies)), np.zeros(len(geometry.bodies))
+    for pair, value in zip(geometry.pairs, values, strict=True):
+        for body in (pair.a, pair.b):
+            sums[geometry.index[body]] += value
+            counts[geometry.index[body]] += 1
+    return (sums / np.maximum(counts, 1)).tolist()
+
+
+def _factors(geometry: Geometry, values: Sequence[float]) -> list[float] | None:
+    """Per-body factors whose products over each pair's two bodies are the pairs' ``values``.
+
+    A body whose pairs all have value 0 takes 0; the others are found along the pairs from a
+    fixed body (which keeps 1) or from the first body of each connected group; None when the
+    pairs ask for two different factors of one body or put a zero next to a positive value.
+    """
+    index = geometry.index
+    edges = [(index[p.a], index[p.b], v) for p, v in zip(geometry.pairs, values, strict=True)]
+    zero = {
+        k for k in range(len(geometry.bodies)) if all(v == 0 for a, b, v in edges if k in (a, b))
+    }
+    factors: dict[int, float] = {k: 0.0 for k in zero}
+    live = [(a, b, v) for a, b, v in edges if a not in zero and b not in zero]
+    if any(v == 0 for *_, v in live):
+        return None
+    roots = sorted(
+        set(range(len(geometry.bodies))) - zero,
+        key=lambda k: geometry.moving(geometry.bodies[k].name),
+    )
+    for root in roots:
+        if root in factors:
+            continue
+        factors[root], frontier = 1.0, [root]
+        while frontier:
+            k = frontier.pop()
+            for a, b, v in live:
+                if k not in (a, b):
+                    continue
+                other = b if k == a else a
+                wanted = v / factors[k]
+                if other not in factors:
+                    factors[other] = wanted
+                    frontier.append(other)
+                elif not math.isclose(factors[other], wanted, rel_tol=1e-12):
+                    return None
+    return [factors.get(k, 1.0) for k in range(len(geometry.bodies))]
+
+
+class _BulletScene(Scene):
+    """The geometry built in a PyBullet client of its own (DIRECT mode, no window)."""
+
+    def __init__(
+        self,
+        geometry: Geometry,
+        poses: list[tuple[np.ndarray, tuple[float, ...]]],
+        velocities: np.ndarray,
+        settings: str,
+        dt: float,
+        coefficients: list[tuple[float, float]],
+        reach: float,
+    ) -> None:
+        self.bullet, self.geometry, self.reach = _bullet(), geometry, reach
+        self.client = _client(settings)
+        # The scene's bodies in the geometry's order, and those it made (the others are planes
+        # the client keeps).
+        self.ids: list[int] = []
+        self.made: list[int] = []
+        try:
+            self._build(poses, velocities, settings == "tuned", dt, coefficients)
+        except BaseException:
+            self.close()
+            raise
+
+    def _call(self, function: str, *args: Any, **kwargs: Any) -> Any:
+        return getattr(self.bullet, function)(*args, physicsClientId=self.client.id, **kwargs)
+
+    def _build(
+        self,
+        poses: list[tuple[np.ndarray, tuple[float, ...]]],
+        velocities: np.ndarray,
+        tuned: bool,
+        dt: float,
+        coefficients: list[tuple[float, float]],
+    ) -> None:
+        self._call("setPhysicsEngineParameter", fixedTimeStep=dt)
+        for k, body in enumerate(self.geometry.bodies):
+            kind = self.geometry.joint(body.name).kind
+            if kind in ("hinge", "slide"):
+                raise NotApplicable(
+                    f"pybullet: the scene's {kind} joint is not built (free, planar and fixed "
+                    "joints are)"
+                )
+            position, (w, *q) = poses[k]
+            place = {"posObj": list(position), "ornObj": [*q, w]}
+            if body.shape == "plane":
+                uid = self._plane(sum(b.shape == "plane" for b in self.geometry.bodies[:k]))
+                self._call("resetBasePositionAndOrientation", uid, **place)
+            else:
+                mass = body.mass if kind != "fixed" else 0.0
+                shape = self._shape(body, tuned)
+                uid = self._call(
+                    "createMultiBody",
+                    mass,
+                    shape,
+                    basePosition=place["posObj"],
+                    baseOrientation=place["ornObj"],
+                )
+                self.made.append(uid)
+            self.ids.append(uid)
+            self._dynamics(uid, body, coefficients[k], velocities[k])
+        self._only_declared_pairs()
+
+    def _plane(self, number: int) -> int:
+        """The client's plane body ``number``, made when the client has no such plane yet."""
+        planes = self.client.planes
+        while len(planes) <= number:
+            shape = self._shape(Body("plane", "plane", ()), False)
+            planes.append(self._call("createMultiBody", 0.0, shape))
+        return planes[number]
+
+    def _dynamics(
+        self, uid: int, body: Body, coefficients: tuple[float, float], velocity: np.ndarray
+    ) -> None:
+        """Coefficients, no damping, inertia and velocity of a body (fixed ones keep still)."""
+        moving = self.geometry.moving(body.name)
+        restitution, friction = coefficients
+        self._call(
+            "changeDynamics",
+            uid,
+            -1,
+            restitution=restitution,
+            lateralFriction=friction,
+            linearDamping=0.0,
+            angularDamping=0.0,
+            **({"localInertiaDiagonal": list(body.inertia)} if moving else {}),
+        )
+        if moving:
+            self._call("resetBaseVelocity", uid, *np.split(velocity, 2))
+
+    def _shape(self, body: Body, tuned: bool) -> int:
+        """The collision shape of ``body`` (a tuned box: spheres at its contact points).
+
+        Made once per description in the client (`_client`).
+        """
+        if body.shape == "box" and tuned:
+            key: tuple = ("corners", *self._corners(body))
+            make = ("createCollisionShapeArray", [self.bullet.GEOM_SPHERE] * (len(key) // 2))
+            arguments = {"radii": list(key[1::2]), "collisionFramePositions": list(key[2::2])}
+        elif body.shape in SIZES:
+            key = (body.shape, body.size)
+            make = ("createCollisionShape", getattr(self.bullet, f"GEOM_{body.shape.upper()}"))
+            arguments = SIZES[body.shape](body.size)
+        else:
+            raise NotApplicable(f"pybullet: Bullet has no {body.shape} shape")
+        shapes = self.client.shapes
+        if key not in shapes:
+            shapes[key] = self._call(*make, **arguments)
+        return shapes[key]
+
+    def _corners(self, body: Body) -> list:
+        """Radius and position (body frame) of a small sphere at each contact point of ``body``.
+
+        Each touches at its point along the pair's normal; the radius is `CORNER_RADIUS` of the
+        body's smallest half-extent.
+        """
+        radius = CORNER_RADIUS * min(body.size)
+        R, centre = body.rotation, np.asarray(body.position)
+        corners = []
+        for pair in self.geometry.pairs:
+            if body.name in (pair.a, pair.b):
+                inward = np.asarray(pair.normal) * (1.0 if body.name == pair.a else -1.0)
+                local = R.T @ (np.asarray(pair.point) + radius * inward - centre)
+                corners += [radius, tuple(local.tolist())]
+        return corners
+
+    def _only_declared_pairs(self) -> None:
+        """Let the bodies of each declared pair collide, and no other two.
+
+        Every two of the scene's bodies and the client's idle planes are set, so that a
+        setting left by an earlier scene on a body id PyBullet gives again does not count.
+        """
+        index = self.geometry.index
+        declared = {
+            frozenset((self.ids[index[p.a]], self.ids[index[p.b]])) for p in self.geometry.pairs
+        }
+        every = self.ids + [uid for uid in self.client.planes if uid not in self.ids]
+        for i, first in enumerate(every):
+            for second in every[:i]:
+                wanted = int(frozenset((first, second)) in declared)
+                self._call("setCollisionFilterPair", first, second, -1, -1, wanted)
+
+    def step(self) -> tuple[list[Force], np.ndarray]:
+        """One stepSimulation: the forces of its contact points, and the bodies' velocities."""
+        self._call("stepSimulation")
+        names = {uid: body.name for uid, body in zip(self.ids, self.geometry.bodies, strict=True)}
+        forces = []
+        for point in self._call("getContactPoints"):
+            on_a, on_b, normal = np.asarray(point[5]), np.asarray(point[6]), np.asarray(point[7])
+            force = point[9] * normal + point[10] * np.asarray(point[11])
+            force = force + point[12] * np.asarray(point[13])
+            forces.append(Force(names[point[1]], names[point[2]], (on_a + on_b) / 2, force))
+        velocities = np.array(
+            [np.concatenate(self._call("getBaseVelocity", uid)) for uid in self.ids]
+        )
+        return forces, velocities
+
+    def distances(self) -> np.ndarray:
+        """Bullet's closest points of each two bodies that touch, each to its nearest pair."""
+        geometry, found = self.geometry, np.full(len(self.geometry.pairs), self.reach)
+        for first, second in {(p.a, p.b) for p in geometry.pairs}:
+            a, b = self.ids[geometry.index[first]], self.ids[geometry.index[second]]
+            for point in self._call("getClosestPoints", a, b, self.reach):
+                j, _ = pair_of(geometry, Force(first, second, np.asarray(point[5]), _NO_FORCE))
+                found[j] = min(found[j], point[8])
+        return found
+
+    def close(self) -> None:
+        """Remove the bodies the scene made from the client, for the next solve."""
+        for uid in self.made:
+            self._call("removeBody", uid)
+        self.ids, self.made = [], []
+
+
+LAWS.register(PyBullet())

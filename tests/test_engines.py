@@ -1,0 +1,368 @@
+"""The engines as laws: the scenes' geometry, PyBullet and MuJoCo against Moreau's law.
+
+Measured (this repository's scenes, the engines' default and tuned settings): PyBullet tuned
+equals Moreau's law to rounding (1e-15) on the chain, the sphere on a wall and the rocking
+block; MuJoCo tuned is 5e-5 from it on the elastic chain and 3e-6 on the block. The defaults
+are the traps: PyBullet multiplies the two bodies' coefficients (a contact of e = 0.8 acts with
+0.64), MuJoCo ignores e (the elastic chain keeps a third of its energy).
+"""
+
+import importlib
+import sys
+
+import numpy as np
+import pytest
+
+import lawbench
+from lawbench.core.geometry import Body, ContactPair, Geometry, Joint
+from lawbench.core.law import Law
+from lawbench.core.registry import Registry
+from lawbench.core.transforms import duplicated
+from lawbench.views import cli
+
+pybullet = pytest.importorskip("pybullet")
+mujoco = pytest.importorskip("mujoco")
+
+# Imported once both engines are known to be installed.
+from lawbench.laws.engines import _base  # noqa: E402
+from lawbench.laws.engines import mujoco as mujoco_law  # noqa: E402
+from lawbench.laws.engines import pybullet as pybullet_law  # noqa: E402
+
+# The scenes that declare their geometry, at their defaults and one other example each.
+SCENES = [
+    ("three_ball_chain", {}),
+    ("three_ball_chain", {"velocities": [1.0, 0.0, -1.0], "e": [0.5, 1.0]}),
+    ("two_balls_wall", {}),
+    ("ball_chain", {"wall": True}),
+    ("bead_column", {"n": 3}),
+    ("sphere_wall", {}),
+    ("rocking_block", {}),
+    ("rocking_block", {"width": 2.0, "height": 1.0}),
+]
+
+
+def relative(a, b, scale):
+    return float(np.abs(np.asarray(a) - np.asarray(b)).max() / np.abs(scale).max())
+
+
+def against_moreau(law, case, settings, **params):
+    """The engine's answer, Moreau's, and their distance relative to the largest velocity."""
+    problem = lawbench.CASES.get(case).build(**params)
+    engine = lawbench.LAWS.get(law).resolve(problem, settings=settings)
+    moreau = lawbench.LAWS.get("moreau").resolve(problem)
+    return engine, moreau, relative(engine.v_plus, moreau.v_plus, problem.v)
+
+
+# 1. The geometry: the scene's problem is its geometry's linear algebra, and the engine's.
+
+
+@pytest.mark.parametrize(("case", "params"), SCENES)
+def test_a_scene_s_problem_is_its_geometry_s(case, params):
+    problem = lawbench.CASES.get(case).build(**params)
+    assert problem.geometry is not None
+    assert _base.geometry_mismatch(problem.geometry, problem) is None
+
+
+def test_a_transformed_problem_is_refused_as_no_longer_its_geometry_s():
+    problem = lawbench.CASES.get("three_ball_chain").build()
+    with pytest.raises(lawbench.NotApplicable, match="3 contacts, its geometry 3 and 2"):
+        lawbench.LAWS.get("pybullet").resolve(duplicated(problem))
+    with pytest.raises(lawbench.NotApplicable, match="the problem's M is not its geometry's"):
+        lawbench.LAWS.get("mujoco").resolve(problem.in_units(2.0, 1.0, 1.0))
+    with pytest.raises(lawbench.NotApplicable, match="the scene declares no geometry"):
+        lawbench.solve("mujoco", "lamina")
+
+
+def engine_columns_mujoco(problem):
+    """Wn and Wt from MuJoCo's contacts at the initial pose: mj_jac at each contact point."""
+    geometry = problem.geometry
+    poses = geometry.poses(_base._displacement(problem, geometry))
+    scene = mujoco_law._MuJoCoScene(geometry, poses, np.zeros((len(poses), 6)), True, 1e-5, 1.0)
+    model, data = scene.model, scene.data
+    mujoco.mj_forward(model, data)
+    # qvel of each generalized velocity: the joints' velocities are linear in the bodies'.
+    Q = np.empty((model.nv, geometry.n))
+    for i, column in enumerate(np.eye(geometry.n)):
+        scene._set_velocities(geometry.body_velocities(column))
+        Q[:, i] = data.qvel
+    Wn, Wt = np.zeros_like(problem.Wn), None if problem.Wt is None else np.zeros_like(problem.Wt)
+    seen = set()
+    for contact in data.contact[: data.ncon]:
+        bodies = [int(model.geom_bodyid[g]) for g in contact.geom]
+        jacobians = []
+        for body in bodies:
+            jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+            mujoco.mj_jac(model, data, jacp, jacr, contact.pos, body)
+            jacobians.append(jacp)
+        first, second = (scene.owner[int(g)] for g in contact.geom)
+        force = _base.Force(second, first, np.array(contact.pos), np.zeros(3))
+        j, sign = _base.pair_of(geometry, force)
+        relative_jacobian = sign * (jacobians[1] - jacobians[0]) @ Q
+        directions = geometry.pairs[j].directions
+        np.testing.assert_allclose(directions[0] @ contact.frame[:3] * sign, 1.0, atol=1e-9)
+        Wn[:, j] = relative_jacobian.T @ directions[0]
+        for k, tangent in enumerate(directions[1:]):
+            Wt[:, j * problem.d + k] = relative_jacobian.T @ tangent
+        seen.add(j)
+    assert seen == set(range(problem.m)), "MuJoCo finds every declared contact"
+    return Wn, Wt
+
+
+def engine_columns_pybullet(problem, step=1e-7):
+    """Wn and Wt from Bullet's contact points, by central differences in each coordinate.
+
+    A normal column is the rate of Bullet's contact distance (getClosestPoints); a tangential
+    one the rate of the material point of each body at Bullet's contact point along the tangent.
+    """
+    geometry = problem.geometry
+    start = _base._displacement(problem, geometry)
+    coefficients = pybullet_law._coefficients(geometry, True)
+    velocities = np.zeros((len(geometry.bodies), 6))
+    scene = pybullet_law._BulletScene(
+        geometry, geometry.poses(start), velocities, "tuned", 1e-4, coefficients, 1.0
+    )
+    try:
+        points = _closest(scene, problem)
+        Wn, Wt = (
+            np.zeros_like(problem.Wn),
+            None if problem.Wt is None else np.zeros_like(problem.Wt),
+        )
+        for i in range(geometry.n):
+            moved = []
+            for h in (step, -step):
+                for uid, (position, (w, *q)) in zip(
+                    scene.ids, geometry.poses(start + h * np.eye(geometry.n)[i]), strict=True
+                ):
+                    pybullet.resetBasePositionAndOrientation(
+                        uid, list(position), [*q, w], physicsClientId=scene.client.id
+                    )
+                moved.append(_closest(scene, problem, points))
+            for j, (plus, minus) in enumerate(zip(*moved, strict=True)):
+                Wn[i, j] = (plus[0] - minus[0]) / (2 * step)
+                for k, tangent in enumerate(geometry.pairs[j].directions[1:]):
+                    Wt[i, j * problem.d + k] = (plus[1] - minus[1]) @ tangent / (2 * step)
+    finally:
+        scene.close()
+    return Wn, Wt
+
+
+def _closest(scene, problem, points=None):
+    """Per pair: Bullet's distance, and where the material points found first now are.
+
+    Without ``points``, the material points at Bullet's contact points, in each body's frame.
+    """
+    geometry, client = problem.geometry, scene.client.id
+    found = {}
+    for pair in geometry.pairs:
+        a, b = (scene.ids[geometry.index[name]] for name in (pair.a, pair.b))
+        for point in pybullet.getClosestPoints(a, b, 1.0, physicsClientId=client):
+            force = _base.Force(pair.a, pair.b, np.asarray(point[5]), np.zeros(3))
+            j, _ = _base.pair_of(geometry, force)
+            frames = [
+                pybullet.getBasePositionAndOrientation(u, physicsClientId=client) for u in (a, b)
+            ]
+            if points is None:
+                on = [np.asarray(point[5]), np.asarray(point[6])]
+                local = [_to_body(frame, p) for frame, p in zip(frames, on, strict=True)]
+                found[j] = (point[8], local)
+            else:
+                world = [_to_world(f, p) for f, p in zip(frames, points[j][1], strict=True)]
+                found[j] = (point[8], world[0] - world[1])
+    return found if points is None else [found[j] for j in range(problem.m)]
+
+
+def _to_body(frame, point):
+    R = np.array(pybullet.getMatrixFromQuaternion(frame[1])).reshape(3, 3)
+    return R.T @ (point - np.asarray(frame[0]))
+
+
+def _to_world(frame, local):
+    R = np.array(pybullet.getMatrixFromQuaternion(frame[1])).reshape(3, 3)
+    return np.asarray(frame[0]) + R @ local
+
+
+@pytest.mark.parametrize(("case", "params"), SCENES)
+@pytest.mark.parametrize("engine", ["mujoco", "pybullet"])
+def test_the_engine_s_contact_jacobians_are_the_scene_s(engine, case, params):
+    problem = lawbench.CASES.get(case).build(**params)
+    columns = engine_columns_mujoco if engine == "mujoco" else engine_columns_pybullet
+    Wn, Wt = columns(problem)
+    np.testing.assert_allclose(Wn, problem.Wn, atol=1e-9 * np.abs(problem.Wn).max())
+    if problem.Wt is not None:
+        np.testing.assert_allclose(Wt, problem.Wt, atol=1e-9 * np.abs(problem.Wt).max())
+
+
+@pytest.mark.parametrize(
+    ("field", "change", "message"),
+    [
+        ("bodies", {"shape": "cone"}, "shape = 'cone'"),
+        ("bodies", {"size": (0.1, 0.1)}, "size has 2 entries"),
+        ("bodies", {"quaternion": (1.0, 1.0, 0.0, 0.0)}, "quaternion .* norm 1"),
+        ("pairs", {"normal": (1.0, 1.0, 0.0)}, "normal .* norm 1"),
+        ("pairs", {"e": 1.5}, "e = 1.5 must lie in"),
+        ("joints", {"kind": "ball"}, "kind = 'ball'"),
+    ],
+)
+def test_a_bad_geometry_field_is_refused_by_name(field, change, message):
+    geometry = lawbench.CASES.get("sphere_wall").build().geometry
+    parts = {"bodies": geometry.bodies, "joints": geometry.joints, "pairs": geometry.pairs}
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        first = type(parts[field][0])(**{**vars(parts[field][0]), **change})
+        Geometry(**{**parts, field: (first, *parts[field][1:])}, **_maps(geometry))
+
+
+def _maps(geometry):
+    return {"to_bodies": geometry.to_bodies, "to_generalized": geometry.to_generalized}
+
+
+def test_a_map_that_moves_a_body_against_its_joint_is_refused():
+    geometry = lawbench.CASES.get("rocking_block").build().geometry
+    B = geometry.to_bodies.copy()
+    B[2, 0] = 1.0  # vx drives the block out of its plane
+    with pytest.raises(lawbench.InvalidProblem, match="against its planar joint"):
+        Geometry(geometry.bodies, geometry.joints, geometry.pairs, B, geometry.to_generalized)
+    ball = Body("ball", "sphere", (0.1,), 1.0, (0.004,) * 3)
+    wall = Body("wall", "plane", ())
+    pair = ContactPair("ball", "wall", (0, 0, 0), (0, 0, 1))
+    with pytest.raises(lawbench.InvalidProblem, match="'wall' moves"):
+        Geometry((ball, wall), (Joint("free", "ball"), Joint("free", "wall")), (pair,), B, B.T)
+
+
+# 2. PyBullet: tuned is Moreau's law; the defaults multiply the coefficients.
+
+
+@pytest.mark.parametrize(
+    ("case", "params"),
+    [
+        ("three_ball_chain", {}),
+        ("ball_chain", {"wall": True, "e": [0.5]}),
+        ("sphere_wall", {"spin": [0.0, 0.0, 0.0]}),
+        ("sphere_wall", {"mu": 0.03}),
+        ("rocking_block", {}),
+    ],
+)
+def test_pybullet_tuned_is_moreau_s_law(case, params):
+    """Measured to 1e-15; asked to 1e-9 (the brief's bound, 2 % on the block, is far looser)."""
+    _, _, error = against_moreau("pybullet", case, "tuned", **params)
+    assert error < 1e-9
+
+
+def test_pybullet_tuned_from_the_command_line(capsys):
+    args = ["solve", "pybullet", "three_ball_chain", "--option", "settings=tuned", "--json"]
+    assert cli.main(args) == 0
+    out = capsys.readouterr()
+    assert out.err == ""
+    np.testing.assert_allclose(
+        __import__("json").loads(out.out)["v_plus"], [-1 / 3, 2 / 3, 2 / 3], atol=1e-9
+    )
+
+
+def test_pybullet_defaults_multiply_the_coefficients_and_keep_a_little_energy():
+    """The trap witnesses: e -> e^2 and mu -> mu^2; the chain at 1/240 s, (-0.331, 0.664, 0.664)."""
+    chain = lawbench.solve("pybullet", "three_ball_chain")
+    np.testing.assert_allclose(chain.v_plus, [-0.331, 0.664, 0.664], atol=2e-3)
+    assert chain.T_plus / chain.T_minus == pytest.approx(0.995, abs=1e-3)
+    problem = lawbench.CASES.get("sphere_wall").build(spin=[0.0, 0.0, 0.0], mu=0.03)
+    sphere = lawbench.LAWS.get("pybullet").resolve(problem)
+    # e^2 = 0.64 of the approach (0.8 tuned), less the 0.3 % the contact slop takes.
+    assert sphere.v_plus[1] / -problem.v[1] == pytest.approx(0.8**2, abs=0.005)
+    assert np.linalg.norm(sphere.Pt) == pytest.approx(0.03**2 * sphere.Pn[0], rel=1e-9)
+
+
+def test_pybullet_meets_gaps_event_by_event():
+    """Contact 1 open by a millimetre: Newton's cradle, as rigid binary impacts give."""
+    outcome = lawbench.solve(
+        "pybullet", "three_ball_chain", gaps=[0.0, 1e-3], options={"settings": "tuned"}
+    )
+    np.testing.assert_allclose(outcome.v_plus, [0.0, 0.0, 1.0], atol=1e-9)
+
+
+def test_pybullet_refuses_coefficients_no_per_body_values_multiply_to():
+    geometry = lawbench.CASES.get("ball_chain").build(n=3, e=[0.0, 1.0]).geometry
+    assert pybullet_law._factors(geometry, [0.0, 1.0]) == [0.0, 1.0, 1.0]
+    assert pybullet_law._factors(geometry, [0.5, 0.5]) == [1.0, 0.5, 1.0]
+    assert pybullet_law._factors(geometry, [1.0, 0.0]) == [1.0, 1.0, 0.0]
+    three = lawbench.CASES.get("ball_chain").build(n=4, e=[0.5, 0.0, 0.5]).geometry
+    assert pybullet_law._factors(three, [0.5, 0.0, 0.5]) is None
+
+
+# 3. MuJoCo: tuned approaches Moreau's law; its defaults ignore e.
+
+
+def test_mujoco_tuned_approaches_moreau_s_law():
+    """Measured 5.2e-5 on the chain and 3.3e-6 on the block; asked 1e-4 and 1e-5."""
+    chain = against_moreau("mujoco", "three_ball_chain", "tuned")
+    assert chain[2] < 1e-4
+    assert against_moreau("mujoco", "rocking_block", "tuned")[2] < 1e-5
+
+
+def test_mujoco_tuned_contacts_leave_at_e():
+    """e mapped to the damping of an oscillator released at zero force: within 1 %."""
+    for e in (0.0, 0.5, 0.8):
+        problem = lawbench.CASES.get("sphere_wall").build(spin=[0, 0, 0], mu=0.0, e=e, angle=0.0)
+        outcome = lawbench.LAWS.get("mujoco").resolve(problem, settings="tuned")
+        assert outcome.v_plus[1] / -problem.v[1] == pytest.approx(e, abs=0.01)
+
+
+def test_mujoco_tuned_friction_of_an_elastic_contact_takes_part_of_the_rebound():
+    """The finding of the module's docstring: 18 % of the rebound lost where Moreau rolls."""
+    engine, moreau, _ = against_moreau("mujoco", "sphere_wall", "tuned", spin=[0.0, 0.0, 0.0])
+    assert engine.v_plus[1] == pytest.approx(0.93, abs=0.01)
+    assert moreau.v_plus[1] == pytest.approx(1.131, abs=1e-3)
+    assert engine.v_plus[5] == pytest.approx(moreau.v_plus[5], rel=0.01)
+
+
+def test_mujoco_defaults_ignore_e():
+    """The trap witness: (0.23, 0.37, 0.39) and 35 % of the energy as first measured, with the
+    contacts found from the first step (0.25, 0.37, 0.38) and 34 %: within 0.03 and 0.02."""
+    chain = lawbench.solve("mujoco", "three_ball_chain")
+    np.testing.assert_allclose(chain.v_plus, [0.23, 0.37, 0.39], atol=0.03)
+    assert chain.T_plus / chain.T_minus == pytest.approx(0.35, abs=0.02)
+
+
+def test_the_damping_ratio_inverts_the_restitution_of_a_released_oscillator():
+    for e in (1e-3, 0.05, np.exp(-2.0), 0.3, 0.9):
+        zeta = mujoco_law.damping_ratio(e)
+        assert mujoco_law.released_restitution(zeta) == pytest.approx(e, rel=1e-9)
+    assert mujoco_law.damping_ratio(1.0) == 0.0
+
+
+# 4. What every engine shares: its budget, its determinism, its listing, its absence.
+
+
+@pytest.mark.parametrize("engine", ["mujoco", "pybullet"])
+def test_an_engine_that_runs_out_of_steps_names_its_budget(engine):
+    with pytest.raises(lawbench.BudgetExceeded, match="max_steps"):
+        lawbench.solve(engine, "three_ball_chain", options={"max_steps": 2})
+
+
+@pytest.mark.parametrize("engine", ["mujoco", "pybullet"])
+def test_an_engine_answers_the_same_twice_and_reports_its_own_velocity(engine):
+    first = lawbench.solve(engine, "sphere_wall", options={"settings": "tuned"})
+    second = lawbench.solve(engine, "sphere_wall", options={"settings": "tuned"})
+    np.testing.assert_array_equal(first.v_plus, second.v_plus)
+    assert first.diagnostics["engine_velocity_gap"] < 1e-3
+
+
+def test_the_engines_are_listed_and_described(capsys):
+    assert cli.main(["list"]) == 0
+    listed = capsys.readouterr().out
+    assert "  mujoco " in listed and "  pybullet " in listed
+    assert cli.main(["describe", "mujoco"]) == 0
+    described = capsys.readouterr().out
+    for setting in ("settings = 'default'", "solref", "solimp", "elliptic", "dt = 0.0"):
+        assert setting in described
+
+
+def test_an_engine_that_is_not_installed_is_listed_with_its_install_command(monkeypatch):
+    """The missing package simulated: its import blocked (None in sys.modules)."""
+    fresh = Registry("law", "lawbench.laws", Law)
+    monkeypatch.setattr("lawbench.core.law.LAWS", fresh)
+    monkeypatch.setitem(sys.modules, "pybullet", None)
+    for name in ("lawbench.laws.engines", "lawbench.laws.engines.mujoco"):
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.delitem(sys.modules, "lawbench.laws.engines.pybullet")
+    monkeypatch.delattr("lawbench.laws.engines")
+    importlib.import_module("lawbench.laws.engines")
+    assert "mujoco" in fresh._entries and "pybullet" not in fresh._entries
+    assert "pip install 'lawbench[engines]'" in fresh.unavailable["pybullet"]
