@@ -77,7 +77,9 @@ def engine_columns_mujoco(problem):
     """Wn and Wt from MuJoCo's contacts at the initial pose: mj_jac at each contact point."""
     geometry = problem.geometry
     poses = geometry.poses(_base._displacement(problem, geometry))
-    scene = mujoco_law._MuJoCoScene(geometry, poses, np.zeros((len(poses), 6)), True, 1e-5, 1.0)
+    scene = mujoco_law._MuJoCoScene(
+        _base.Start(geometry, poses, np.zeros((len(poses), 6)), "tuned", 1e-5, 1.0)
+    )
     model, data = scene.model, scene.data
     mujoco.mj_forward(model, data)
     # qvel of each generalized velocity: the joints' velocities are linear in the bodies'.
@@ -119,7 +121,7 @@ def engine_columns_pybullet(problem, step=1e-7):
     coefficients = pybullet_law._coefficients(geometry, True)
     velocities = np.zeros((len(geometry.bodies), 6))
     scene = pybullet_law._BulletScene(
-        geometry, geometry.poses(start), velocities, "tuned", 1e-4, coefficients, 1.0
+        _base.Start(geometry, geometry.poses(start), velocities, "tuned", 1e-4, 1.0), coefficients
     )
     try:
         points = _closest(scene, problem)

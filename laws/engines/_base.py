@@ -123,6 +123,39 @@ class Force:
     force: np.ndarray
 
 
+@dataclass(frozen=True)
+class Start:
+    """What an engine builds a scene from: the geometry placed at the impact, and how to step.
+
+    Attributes
+    ----------
+    geometry : Geometry
+        The scene's bodies, joints and contact pairs.
+    poses : list of (array (3,), tuple of 4 floats)
+        Each body's position and orientation quaternion (w, x, y, z), the gaps applied.
+    velocities : array (B, 6)
+        Each body's pre-impact velocity: centre of mass, then angular (world frame).
+    settings : str
+        'default' or 'tuned'.
+    dt : float
+        The engine's step (s).
+    reach : float
+        Distance beyond which a pair is not part of the impact (`Scene.distances`).
+    """
+
+    geometry: Geometry
+    poses: list[tuple[np.ndarray, tuple[float, ...]]]
+    velocities: np.ndarray
+    settings: str
+    dt: float
+    reach: float
+
+    @property
+    def tuned(self) -> bool:
+        """Whether the engine is set as rigid and faithful to e and mu as it allows."""
+        return self.settings == "tuned"
+
+
 class Scene(ABC):
     """A scene built in an engine, its bodies placed and moving at their pre-impact velocity."""
 
@@ -138,7 +171,7 @@ class Scene(ABC):
     def distances(self) -> np.ndarray:
         """The engine's signed distance of each pair's bodies near its point (m,).
 
-        At most the scene's reach (`EngineLaw._open`): farther, a pair is not part of the
+        At most the scene's reach (`Start.reach`): farther, a pair is not part of the
         impact.
         """
 
@@ -210,7 +243,7 @@ class EngineLaw(Law):
         velocities = geometry.body_velocities(problem.v)
         # Pairs farther apart than the largest gap and body cannot close within the impact.
         reach = float(problem.gaps.max()) + max(max(b.size, default=0.0) for b in geometry.bodies)
-        scene = self._open(geometry, poses, velocities, settings, dt, reach)
+        scene = self._open(Start(geometry, poses, velocities, settings, dt, reach))
         try:
             P, steps, engine_v = _step_through(scene, problem, geometry, dt)
         finally:
@@ -229,18 +262,8 @@ class EngineLaw(Law):
         return outcome
 
     @abstractmethod
-    def _open(
-        self,
-        geometry: Geometry,
-        poses: list[tuple[np.ndarray, tuple[float, ...]]],
-        velocities: np.ndarray,
-        settings: str,
-        dt: float,
-        reach: float,
-    ) -> Scene:
-        """Build the scene in the engine at ``poses``, moving at ``velocities`` (B, 6).
-
-        ``reach`` bounds the distances the scene reports (`Scene.distances`).
+    def _open(self, start: Start) -> Scene:
+        """Build the scene in the engine at ``start``'s poses, moving at its velocities.
 
         Raises
         ------

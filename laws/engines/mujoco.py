@@ -65,7 +65,7 @@ import scipy.optimize
 
 from lawbench.checks.regions import oblique_contacts, option
 from lawbench.core.errors import NotApplicable
-from lawbench.core.geometry import Body, ContactPair, Geometry, rotation_matrix
+from lawbench.core.geometry import Body, ContactPair, rotation_matrix
 from lawbench.core.law import LAWS
 from lawbench.core.verdicts import Claim
 from lawbench.laws._claims import RIGID_DISPERSION
@@ -73,6 +73,7 @@ from lawbench.laws.engines._base import (
     EngineLaw,
     Force,
     Scene,
+    Start,
     elastic_contact,
     engine_options,
     quietly,
@@ -193,16 +194,8 @@ class MuJoCo(EngineLaw):
         ),
     )
 
-    def _open(
-        self,
-        geometry: Geometry,
-        poses: list[tuple[np.ndarray, tuple[float, ...]]],
-        velocities: np.ndarray,
-        settings: str,
-        dt: float,
-        reach: float,
-    ) -> Scene:
-        return _MuJoCoScene(geometry, poses, velocities, settings == "tuned", dt, reach)
+    def _open(self, start: Start) -> Scene:
+        return _MuJoCoScene(start)
 
 
 def _numbers(values: object) -> str:
@@ -234,21 +227,14 @@ def _joints(kind: str, axis: np.ndarray, anchor: np.ndarray, centre: np.ndarray)
 class _MuJoCoScene(Scene):
     """The geometry as an MJCF model, with its data at the pre-impact state."""
 
-    def __init__(
-        self,
-        geometry: Geometry,
-        poses: list[tuple[np.ndarray, tuple[float, ...]]],
-        velocities: np.ndarray,
-        tuned: bool,
-        dt: float,
-        reach: float,
-    ) -> None:
-        self.mujoco, self.geometry, self.dt, self.reach = _mujoco(), geometry, dt, reach
+    def __init__(self, start: Start) -> None:
+        geometry, poses = start.geometry, start.poses
+        self.mujoco, self.geometry, self.dt, self.reach = _mujoco(), geometry, start.dt, start.reach
         # Each body's joints (none for a fixed body) and rotation at its pose.
         self.joints: list[list[tuple]] = []
         self.rotations = [rotation_matrix(quaternion) for _, quaternion in poses]
         try:
-            self.model = self.mujoco.MjModel.from_xml_string(self._model(poses, tuned))
+            self.model = self.mujoco.MjModel.from_xml_string(self._model(poses, start.tuned))
         except ValueError as exc:
             raise NotApplicable(f"mujoco: the scene's model does not compile ({exc})") from None
         self.data = self.mujoco.MjData(self.model)
@@ -257,7 +243,7 @@ class _MuJoCoScene(Scene):
         self.ids = [self.model.body(f"b{k}").id if j else None for k, j in enumerate(self.joints)]
         geoms = {name: geom for geom, name in self.owner.items()}
         self.pair_geoms = [(geoms[pair.a], geoms[pair.b]) for pair in geometry.pairs]
-        self._set_velocities(velocities)
+        self._set_velocities(start.velocities)
         self.mujoco.mj_kinematics(self.model, self.data)
         self.force, self.velocity = np.zeros(6), np.zeros(6)
 

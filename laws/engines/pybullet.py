@@ -74,6 +74,7 @@ from lawbench.laws.engines._base import (
     EngineLaw,
     Force,
     Scene,
+    Start,
     engine_options,
     pair_of,
     quietly,
@@ -232,17 +233,8 @@ class PyBullet(EngineLaw):
         ),
     )
 
-    def _open(
-        self,
-        geometry: Geometry,
-        poses: list[tuple[np.ndarray, tuple[float, ...]]],
-        velocities: np.ndarray,
-        settings: str,
-        dt: float,
-        reach: float,
-    ) -> Scene:
-        coefficients = _coefficients(geometry, settings == "tuned")
-        return _BulletScene(geometry, poses, velocities, settings, dt, coefficients, reach)
+    def _open(self, start: Start) -> Scene:
+        return _BulletScene(start, _coefficients(start.geometry, start.tuned))
 
 
 def _coefficients(geometry: Geometry, tuned: bool) -> list[tuple[float, float]]:
@@ -326,24 +318,15 @@ def _factors(geometry: Geometry, values: Sequence[float]) -> list[float] | None:
 class _BulletScene(Scene):
     """The geometry built in a PyBullet client of its own (DIRECT mode, no window)."""
 
-    def __init__(
-        self,
-        geometry: Geometry,
-        poses: list[tuple[np.ndarray, tuple[float, ...]]],
-        velocities: np.ndarray,
-        settings: str,
-        dt: float,
-        coefficients: list[tuple[float, float]],
-        reach: float,
-    ) -> None:
-        self.bullet, self.geometry, self.reach = _bullet(), geometry, reach
-        self.client = _client(settings)
+    def __init__(self, start: Start, coefficients: list[tuple[float, float]]) -> None:
+        self.bullet, self.geometry, self.reach = _bullet(), start.geometry, start.reach
+        self.client = _client(start.settings)
         # The scene's bodies in the geometry's order, and those it made (the others are planes
         # the client keeps).
         self.ids: list[int] = []
         self.made: list[int] = []
         try:
-            self._build(poses, velocities, settings == "tuned", dt, coefficients)
+            self._build(start, coefficients)
         except BaseException:
             self.close()
             raise
@@ -351,15 +334,9 @@ class _BulletScene(Scene):
     def _call(self, function: str, *args: Any, **kwargs: Any) -> Any:
         return getattr(self.bullet, function)(*args, physicsClientId=self.client.id, **kwargs)
 
-    def _build(
-        self,
-        poses: list[tuple[np.ndarray, tuple[float, ...]]],
-        velocities: np.ndarray,
-        tuned: bool,
-        dt: float,
-        coefficients: list[tuple[float, float]],
-    ) -> None:
-        self._call("setPhysicsEngineParameter", fixedTimeStep=dt)
+    def _build(self, start: Start, coefficients: list[tuple[float, float]]) -> None:
+        poses, velocities, tuned = start.poses, start.velocities, start.tuned
+        self._call("setPhysicsEngineParameter", fixedTimeStep=start.dt)
         for k, body in enumerate(self.geometry.bodies):
             kind = self.geometry.joint(body.name).kind
             if kind in ("hinge", "slide"):
