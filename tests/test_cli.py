@@ -452,7 +452,7 @@ def test_a_solve_of_built_in_entries_reads_no_metadata_and_no_batch_code(module)
     assert done.stdout.strip() == "False"
 
 
-def test_describe_names_every_scenes_ground_truth():
+def test_describe_names_every_scenes_ground_truth(capsys):
     """A scene's outcomes are measured against its declared ground truth: describe prints it,
     with why, on a line of its own. Every scene has one, and none is a rigid law under test:
     a closed form, or the time-domain model of compliant contact."""
@@ -460,10 +460,10 @@ def test_describe_names_every_scenes_ground_truth():
         truth = case.ground_truth
         assert truth is not None, case.name
         assert truth.law in (None, "compliant"), (case.name, truth.law)
-    commands = [[sys.executable, "-m", "lawbench", "describe", name] for name in CASES]
-    for name, done in zip(CASES, run_together(*commands), strict=True):
-        assert done.returncode == 0, done.stderr
-        (line,) = [line for line in done.stdout.splitlines() if line.startswith("ground truth:")]
+    for name in CASES:
+        assert cli.main(["describe", name]) == 0
+        stdout = capsys.readouterr().out
+        (line,) = [line for line in stdout.splitlines() if line.startswith("ground truth:")]
         truth = lawbench.CASES[name].ground_truth
         expected = (
             f"ground truth: {truth.describe()}: {truth.why}" if truth else "ground truth: none"

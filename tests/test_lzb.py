@@ -171,6 +171,7 @@ def test_each_cycle_of_each_contact_obeys_stronges_coefficient(case, params, var
     assert max(cycles(outcome)) >= 2 or case == "three_ball_chain"
 
 
+@pytest.mark.slow  # a random sweep; the common checks hold every scene's energy
 def test_no_run_gains_energy():
     """Stronge's coefficient at every contact cannot create energy (the released work never
     exceeds the compression work): random chains with and without a wall, random masses,
@@ -426,6 +427,7 @@ def test_the_block_shares_its_friction_between_corners_on_one_floor_line(width, 
     assert outcome.dT <= 0
 
 
+@pytest.mark.slow  # a random sweep; the common checks hold every scene's energy
 def test_random_rough_ladders_stay_admissible_and_dissipative():
     """Coulomb's law dissipates and Stronge's coefficient releases at most the compression work
     (Zhang et al. 2013): random coefficients, angles and velocities of the ladder, both

@@ -1,5 +1,6 @@
 """The grid of ``lawbench run`` as typed, its tidy table as pandas reads it, its progress."""
 
+import contextlib
 import io
 import json
 import math
@@ -19,14 +20,21 @@ import lawbench
 from lawbench.core.verdicts import Verdict
 from lawbench.studies.grid import RunSpec, parse_values
 from lawbench.studies.runner import _progress
+from lawbench.views.cli import main
 
 CHAIN = ["--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial"]
 
 
 def lawbench_cli(*args, cwd):
-    return subprocess.run(
-        [sys.executable, "-m", "lawbench", *args], cwd=cwd, capture_output=True, text=True
-    )
+    """The command line run in this process, in the folder ``cwd``: its exit code and output."""
+    out, err, here = io.StringIO(), io.StringIO(), Path.cwd()
+    os.chdir(cwd)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = main(list(args))
+    finally:
+        os.chdir(here)
+    return subprocess.CompletedProcess(args, code, out.getvalue(), err.getvalue())
 
 
 @pytest.fixture(scope="module")
