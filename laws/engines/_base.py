@@ -35,7 +35,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from lawbench.core.errors import SolverFailure
-from lawbench.core.geometry import TOLERANCE, Geometry
+from lawbench.core.geometry import TOLERANCE, Body, ContactPair, Geometry
 from lawbench.core.law import Law, current_budget
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
@@ -53,6 +53,9 @@ APPROACH = 1e-6
 # a contact once its bodies touch or overlap, and bodies placed touching are apart by rounding
 # as often as not (Bullet's sphere-sphere test then finds no contact at all).
 OVERLAP = 1e-9
+# The radius of the small spheres a box touches through where an engine builds it so, over the
+# box's smallest half-extent.
+CORNER_RADIUS = 1e-3
 # The install command of the engines.
 INSTALL = "pip install 'lawbench[engines]'"
 
@@ -210,7 +213,7 @@ class EngineLaw(Law):
         velocities = geometry.body_velocities(problem.v)
         # Pairs farther apart than the largest gap and body cannot close within the impact.
         reach = float(problem.gaps.max()) + max(max(b.size, default=0.0) for b in geometry.bodies)
-        scene = self._open(geometry, poses, velocities, settings, dt, reach)
+        scene = self._open(problem, poses, velocities, settings, dt, reach)
         try:
             P, steps, engine_v = _step_through(scene, problem, geometry, dt)
         finally:
@@ -231,22 +234,44 @@ class EngineLaw(Law):
     @abstractmethod
     def _open(
         self,
-        geometry: Geometry,
+        problem: ImpactProblem,
         poses: list[tuple[np.ndarray, tuple[float, ...]]],
         velocities: np.ndarray,
         settings: str,
         dt: float,
         reach: float,
     ) -> Scene:
-        """Build the scene in the engine at ``poses``, moving at ``velocities`` (B, 6).
+        """Build ``problem``'s geometry in the engine at ``poses``, moving at ``velocities`` (B, 6).
 
-        ``reach`` bounds the distances the scene reports (`Scene.distances`).
+        ``reach`` bounds the distances the scene reports (`Scene.distances`); the problem's
+        contacts carry what the geometry does not (their stiffness).
 
         Raises
         ------
         NotApplicable
             For a shape, joint or set of coefficients the engine cannot build.
         """
+
+
+def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors of the plane normal to ``normal``, ``(first, second, normal)`` direct."""
+    first = np.cross(normal, [1.0, 0.0, 0.0])
+    if np.linalg.norm(first) < 0.5:
+        first = np.cross(normal, [0.0, 1.0, 0.0])
+    first /= np.linalg.norm(first)
+    return first, np.cross(normal, first)
+
+
+def corner(body: Body, pair: ContactPair) -> tuple[float, np.ndarray]:
+    """Radius and centre (body frame) of a small sphere of ``body`` touching at ``pair``'s point.
+
+    It touches there along the pair's normal; its radius is `CORNER_RADIUS` of the body's
+    smallest size.
+    """
+    radius = CORNER_RADIUS * min(body.size)
+    inward = np.asarray(pair.normal) * (1.0 if body.name == pair.a else -1.0)
+    centre = np.asarray(pair.point) + radius * inward - np.asarray(body.position)
+    return radius, body.rotation.T @ centre
 
 
 def geometry_mismatch(geometry: Geometry, problem: ImpactProblem) -> str | None:

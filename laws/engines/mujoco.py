@@ -67,6 +67,7 @@ from lawbench.checks.regions import oblique_contacts, option
 from lawbench.core.errors import NotApplicable
 from lawbench.core.geometry import Body, ContactPair, Geometry, rotation_matrix
 from lawbench.core.law import LAWS
+from lawbench.core.problem import ImpactProblem
 from lawbench.core.verdicts import Claim
 from lawbench.laws._claims import RIGID_DISPERSION
 from lawbench.laws.engines._base import (
@@ -75,6 +76,7 @@ from lawbench.laws.engines._base import (
     Scene,
     elastic_contact,
     engine_options,
+    plane_axes,
     quietly,
     require,
 )
@@ -195,14 +197,15 @@ class MuJoCo(EngineLaw):
 
     def _open(
         self,
-        geometry: Geometry,
+        problem: ImpactProblem,
         poses: list[tuple[np.ndarray, tuple[float, ...]]],
         velocities: np.ndarray,
         settings: str,
         dt: float,
         reach: float,
     ) -> Scene:
-        return _MuJoCoScene(geometry, poses, velocities, settings == "tuned", dt, reach)
+        tuned = settings == "tuned"
+        return _MuJoCoScene(problem.geometry, poses, velocities, tuned, dt, reach)
 
 
 def _numbers(values: object) -> str:
@@ -219,15 +222,8 @@ def _joints(kind: str, axis: np.ndarray, anchor: np.ndarray, centre: np.ndarray)
     if kind == "free":
         return [("free", None, centre)]
     if kind == "planar":
-        first = np.cross(axis, [1.0, 0.0, 0.0])
-        if np.linalg.norm(first) < 0.5:
-            first = np.cross(axis, [0.0, 1.0, 0.0])
-        first /= np.linalg.norm(first)
-        return [
-            ("slide", first, centre),
-            ("slide", np.cross(axis, first), centre),
-            ("hinge", axis, centre),
-        ]
+        first, second = plane_axes(axis)
+        return [("slide", first, centre), ("slide", second, centre), ("hinge", axis, centre)]
     return [(kind, axis, anchor)]
 
 
