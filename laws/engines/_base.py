@@ -183,6 +183,7 @@ class EngineLaw(Law):
     """
 
     tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="dt")
+    engine = True
     # The engine resolves time itself: it receives the gaps and moves the bodies apart by them.
     follows_gaps = True
     # The engine reads lengths, times and its settings in SI units.
