@@ -67,7 +67,7 @@ Moreau's law (its corners leave at 1e-3 of their approach, `LEAST_RESTITUTION`),
 frictionless block 1e-5; the sphere on a wall 2e-4 from it, 3e-3 without spin (the sphere
 rolls after the impact, and the regularized friction lets it creep). Struck head-on, a sphere
 leaves at e to 1e-4 for e = 0.3, 0.5, 0.8 and 1. Cost per impact: some 15 ms at the defaults
-(building the plant dominates), 50 to 400 ms tuned.
+(a third building the plant, the rest stepping it), 50 to 400 ms tuned.
 """
 
 from __future__ import annotations
