@@ -156,6 +156,8 @@ class RockingBlock(Case):
         _specs.restitution(0.0, "Newton's restitution coefficient of both corners"),
         _specs.friction(0.5, "Coulomb friction coefficient of both corners"),
     )
+    # A frictional impact of a box at two corners: the engines' cost per impact with friction.
+    bench_roles = ("engines",)
     requires = Tags(friction=True, several_contacts=True)
     ground_truth = GroundTruth(
         why="Housner's plastic impact is exact where its premises hold (e = 0, the landing "

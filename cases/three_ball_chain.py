@@ -70,8 +70,9 @@ class ThreeBallChain(TwoContactChain):
     )
     requires = Tags(several_contacts=True)
     pairs = ((0, 1), (1, 2))
-    # The smallest multiple impact: its start-up is the cost of the smallest command.
-    bench_roles = ("start_up",)
+    # The smallest multiple impact: its start-up is the cost of the smallest command, and the
+    # engines' cost per impact of a multiple impact.
+    bench_roles = ("start_up", "engines")
     ground_truth = SPRINGS
     references = (
         Reference(

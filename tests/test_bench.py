@@ -7,7 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from lawbench.bench import report, start_up_command, subject
+from lawbench.bench import report, start_up_command, subject, subjects
+from lawbench.bench.impacts import engine_impacts
 from lawbench.bench.peer import (
     PEER_SCRIPT,
     ask,
@@ -35,7 +36,7 @@ def test_the_benchmark_prints_every_figure_with_its_peer():
         "n-ball chain",
         "bytecode cached",
     )
-    for line in (*lines, "from its parameters"):
+    for line in (*lines, "from its parameters", "engines on "):
         assert line in text
     integrating = [
         law.name for law in LAWS.values() if any(s.name == "max_events" for s in law.options)
@@ -47,6 +48,24 @@ def test_the_benchmark_prints_every_figure_with_its_peer():
     assert "x clarabel direct" in text and "x numpy enumeration" in text
     # `bench --problems` asks the same function whether Siconos is there.
     assert ("x Siconos Lemke" in text) == siconos_available()
+
+
+def test_the_bench_prints_each_engine_s_cost_per_impact_at_each_setting():
+    """One timed solve each (about 2 s): a line per engine, setting and scene, with its ratio to
+    the rigid law's solve of the same problem."""
+    engines = [law for law in LAWS.values() if law.engine]
+    if not engines:
+        pytest.skip("no engine installed")
+    lines = engine_impacts(1)
+    peer = subject(LAWS, "lcp")
+    scenes = subjects(CASES, "engines")
+    assert {"three_ball_chain", "rocking_block"} <= set(scenes)
+    for scene in scenes:
+        start = lines.index(f"engines on {scene} (median cost per impact; timed solves each: 1):")
+        block = lines[start + 1 : start + 1 + 2 * len(engines)]
+        labels = {line.split()[0] + " " + line.split()[1] for line in block}
+        assert labels == {f"{law.name} {s}" for law in engines for s in ("default", "tuned")}
+        assert all(line.endswith(f"x {peer}") for line in block), block
 
 
 def test_the_bench_subjects_are_the_ones_laws_and_scenes_declare(monkeypatch):

@@ -1,7 +1,7 @@
 """The bench: the cost of lawbench's answers, against peers measured in the same run.
 
 Owns ``lawbench bench``: the timings and the peers called directly (`lawbench.bench.timing`),
-the figures of small impacts, batches, long and integrating chains and start-up
+the figures of small impacts, batches, long and integrating chains, the engines and start-up
 (`lawbench.bench.impacts`), every law on a folder of problem files with its guarded rows
 (`lawbench.bench.problems`) and their performance profiles (`lawbench.bench.profiles`), and
 Siconos as a peer (`lawbench.bench.peer`, its solvers in `lawbench.bench.siconos_peer`, a
@@ -14,7 +14,7 @@ never the fitting.
 from lawbench.bench.impacts import report
 from lawbench.bench.problems import COLUMNS, SOLVED_FC3D, bench_problems, solvers
 from lawbench.bench.profiles import performance_profiles, problems_summary
-from lawbench.bench.roles import ROLES, start_up_command, subject
+from lawbench.bench.roles import ROLES, start_up_command, subject, subjects
 
 __all__ = [
     "COLUMNS",
@@ -27,4 +27,5 @@ __all__ = [
     "solvers",
     "start_up_command",
     "subject",
+    "subjects",
 ]

@@ -17,12 +17,13 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
+from typing import Any
 
 import clarabel
 import numpy as np
 
 from lawbench.bench.peer import python_loop, siconos_lemke, siconos_python
-from lawbench.bench.roles import start_up_command, subject
+from lawbench.bench.roles import start_up_command, subject, subjects
 from lawbench.bench.timing import (
     alternated,
     best_time,
@@ -35,7 +36,7 @@ from lawbench.bench.timing import (
 from lawbench.cases._chains import chain_problem
 from lawbench.core.batch import ProblemBatch
 from lawbench.core.case import CASES
-from lawbench.core.errors import SolverFailure
+from lawbench.core.errors import LawbenchError, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import solve, solve_batch
@@ -327,6 +328,64 @@ def _elastic_chain(balls: int) -> ImpactProblem:
     return chain_problem([1.0] * balls, velocities, pairs, ones, ones, [1.5] * (balls - 1))
 
 
+def engine_impacts(repeats: int) -> list[str]:
+    """Each engine's median cost per impact, at each of its settings, on the engines' scenes.
+
+    The engines are the registered laws whose ``engine`` is true, their settings the choices of
+    their option ``settings``; the scenes those of the role ``engines``, at their defaults. Each
+    figure is the median of ``repeats`` solves after one untimed solve (an engine's first
+    loads its package), against the ``lcp`` law's solve of the same problem (the rigid law the
+    tuned engines aim at), timed in the same alternated rounds. A solve that fails prints its
+    error in place of a time.
+    """
+    engines = [law for law in LAWS.values() if law.engine]
+    if not engines:
+        return ["engines: none installed"]
+    peer = LAWS[subject(LAWS, "lcp")]
+    lines = []
+    for scene in subjects(CASES, "engines"):
+        problem = CASES[scene].build()
+        calls: dict[str, Callable[[], object]] = {peer.name: lambda p=problem: peer.resolve(p)}
+        for law in engines:
+            settings = next(spec for spec in law.options if spec.name == "settings")
+            for setting in settings.choices:
+                calls[f"{law.name} {setting}"] = lambda p=problem, e=law, s=setting: e.resolve(
+                    p, settings=s
+                )
+        medians = _median_alternated(calls, repeats)
+        lines.append(f"engines on {scene} (median cost per impact; timed solves each: {repeats}):")
+        reference = medians.pop(peer.name)
+        for label, median in medians.items():
+            if isinstance(median, str) or isinstance(reference, str):
+                lines.append(f"  {label:<46}{median if isinstance(median, str) else reference}")
+            else:
+                lines.append(row(label, median, {peer.name: reference}))
+        if not isinstance(reference, str):
+            lines.append(f"  {peer.name:<46}{duration(reference):>12}")
+    return lines
+
+
+def _median_alternated(calls: dict[str, Callable[[], object]], repeats: int) -> dict[str, Any]:
+    """The median wall time of each call over ``repeats`` rounds that make every call in turn.
+
+    Each is made once untimed first; a call that raises gives its error's line instead.
+    """
+    times: dict[str, Any] = {}
+    for name, call in calls.items():
+        try:
+            call()
+            times[name] = []
+        except LawbenchError as error:
+            times[name] = f"{type(error).__name__}: {error}"
+    for _ in range(repeats):
+        for name, call in calls.items():
+            if isinstance(times[name], list):
+                start = time.perf_counter()
+                call()
+                times[name].append(time.perf_counter() - start)
+    return {name: t if isinstance(t, str) else float(np.median(t)) for name, t in times.items()}
+
+
 def start_up(repeats: int) -> list[str]:
     """Whole-process time of the small command `start_up_command` against importing numpy.
 
@@ -375,6 +434,7 @@ def report(quick: bool = False) -> str:
         *(long_chains((100, 1000), repeats) if quick else long_chains(CHAINS, repeats, 1000)),
         *chain_from_scene(SCENE_CHAIN, repeats),
         *integrating_chains(QUICK_INTEGRATING_SIZES if quick else INTEGRATING_SIZES),
+        *engine_impacts(repeats),
         *start_up(repeats),
     ]
     return "\n".join(lines)

@@ -17,8 +17,10 @@ ROLES = {
     "lcp": "the law timed against the LCP peers",
     # the law and the scene of the small command whose start-up is timed;
     "start_up": "the law and scene of the timed start-up command",
-    # the scene of n balls in a row (its parameter ``n``), solved from its parameters.
+    # the scene of n balls in a row (its parameter ``n``), solved from its parameters;
     "long_chain": "the n-ball chain scene solved from its parameters",
+    # the scenes every engine (a law whose ``engine`` is true) is timed on, at each setting.
+    "engines": "the scenes the engines' cost per impact is measured on",
 }
 
 
@@ -30,10 +32,21 @@ def subject(registry: Registry, role: str) -> str:
     InvalidProblem
         When no entry declares it.
     """
-    for name, entry in registry.items():
-        if role in entry.bench_roles:
-            return name
-    raise InvalidProblem(f"no {registry.kind} declares the bench role {role!r} ({ROLES[role]})")
+    return subjects(registry, role)[0]
+
+
+def subjects(registry: Registry, role: str) -> list[str]:
+    """The names of every entry of ``registry`` (by name) that declares ``role``.
+
+    Raises
+    ------
+    InvalidProblem
+        When no entry declares it.
+    """
+    names = [name for name, entry in registry.items() if role in entry.bench_roles]
+    if not names:
+        raise InvalidProblem(f"no {registry.kind} declares the bench role {role!r} ({ROLES[role]})")
+    return names
 
 
 def start_up_command() -> tuple[str, ...]:

@@ -212,6 +212,9 @@ class Law(ABC):
     takes_sparse: ClassVar[bool] = False
     # The roles the law plays in ``lawbench bench`` (`lawbench.bench.roles.ROLES`).
     bench_roles: ClassVar[tuple[str, ...]] = ()
+    # Whether the law is a rigid-body engine stepping a scene's geometry (option ``settings``
+    # names the engine's settings): ``lawbench bench`` times each engine at each setting.
+    engine: ClassVar[bool] = False
     # Whether the law's answer in other units of mass, velocity and time is its answer scaled:
     # true of a law that reads no dimensional contact parameter but the stiffness and the gaps.
     # `resolve` then solves a problem of extreme scale in units near it (`ImpactProblem.units`)

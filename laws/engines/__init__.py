@@ -1,4 +1,4 @@
-"""Rigid-body engines as impact laws: PyBullet and MuJoCo, held to the same checks as any law.
+"""Rigid-body engines as impact laws: PyBullet, MuJoCo and Drake, held to the checks of any law.
 
 Each engine is a law (`lawbench.laws.engines._base.EngineLaw`) that builds the scene's declared
 geometry in the engine, steps through the impact and returns an ordinary outcome; a scene that
@@ -11,13 +11,13 @@ import importlib
 
 from lawbench.core.law import LAWS
 
-# The engine modules, each named after the package it drives.
-ENGINES = ("mujoco", "pybullet")
+# The engine modules, each named after the engine it drives, and the package it imports.
+ENGINES = {"drake": "pydrake", "mujoco": "mujoco", "pybullet": "pybullet"}
 
-for _engine in ENGINES:
+for _engine, _package in ENGINES.items():
     try:
         importlib.import_module(f"{__name__}.{_engine}")
     except ModuleNotFoundError as missing:
-        if missing.name != _engine:
+        if missing.name != _package:
             raise
         LAWS.missing(_engine, f"missing dependency: {missing}")

@@ -35,7 +35,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from lawbench.core.errors import SolverFailure
-from lawbench.core.geometry import TOLERANCE, Geometry
+from lawbench.core.geometry import TOLERANCE, Body, ContactPair, Geometry
 from lawbench.core.law import Law, current_budget
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
@@ -53,6 +53,9 @@ APPROACH = 1e-6
 # a contact once its bodies touch or overlap, and bodies placed touching are apart by rounding
 # as often as not (Bullet's sphere-sphere test then finds no contact at all).
 OVERLAP = 1e-9
+# The radius of the small spheres a box touches through where an engine builds it so, over the
+# box's smallest half-extent.
+CORNER_RADIUS = 1e-3
 # The install command of the engines.
 INSTALL = "pip install 'lawbench[engines]'"
 
@@ -129,8 +132,9 @@ class Start:
 
     Attributes
     ----------
-    geometry : Geometry
-        The scene's bodies, joints and contact pairs.
+    problem : ImpactProblem
+        The impact: its geometry (bodies, joints, contact pairs) and its contacts, which carry
+        what the geometry does not (their stiffness).
     poses : list of (array (3,), tuple of 4 floats)
         Each body's position and orientation quaternion (w, x, y, z), the gaps applied.
     velocities : array (B, 6)
@@ -143,12 +147,17 @@ class Start:
         Distance beyond which a pair is not part of the impact (`Scene.distances`).
     """
 
-    geometry: Geometry
+    problem: ImpactProblem
     poses: list[tuple[np.ndarray, tuple[float, ...]]]
     velocities: np.ndarray
     settings: str
     dt: float
     reach: float
+
+    @property
+    def geometry(self) -> Geometry:
+        """The scene's bodies, joints and contact pairs."""
+        return self.problem.geometry
 
     @property
     def tuned(self) -> bool:
@@ -213,6 +222,7 @@ class EngineLaw(Law):
     """
 
     tags = Tags(friction=True, several_contacts=True, spatial=True, accuracy_knob="dt")
+    engine = True
     # The engine resolves time itself: it receives the gaps and moves the bodies apart by them.
     follows_gaps = True
     # The engine reads lengths, times and its settings in SI units.
@@ -243,7 +253,7 @@ class EngineLaw(Law):
         velocities = geometry.body_velocities(problem.v)
         # Pairs farther apart than the largest gap and body cannot close within the impact.
         reach = float(problem.gaps.max()) + max(max(b.size, default=0.0) for b in geometry.bodies)
-        scene = self._open(Start(geometry, poses, velocities, settings, dt, reach))
+        scene = self._open(Start(problem, poses, velocities, settings, dt, reach))
         try:
             P, steps, engine_v = _step_through(scene, problem, geometry, dt)
         finally:
@@ -270,6 +280,27 @@ class EngineLaw(Law):
         NotApplicable
             For a shape, joint or set of coefficients the engine cannot build.
         """
+
+
+def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors of the plane normal to ``normal``, ``(first, second, normal)`` direct."""
+    first = np.cross(normal, [1.0, 0.0, 0.0])
+    if np.linalg.norm(first) < 0.5:
+        first = np.cross(normal, [0.0, 1.0, 0.0])
+    first /= np.linalg.norm(first)
+    return first, np.cross(normal, first)
+
+
+def corner(body: Body, pair: ContactPair) -> tuple[float, np.ndarray]:
+    """Radius and centre (body frame) of a small sphere of ``body`` touching at ``pair``'s point.
+
+    It touches there along the pair's normal; its radius is `CORNER_RADIUS` of the body's
+    smallest size.
+    """
+    radius = CORNER_RADIUS * min(body.size)
+    inward = np.asarray(pair.normal) * (1.0 if body.name == pair.a else -1.0)
+    centre = np.asarray(pair.point) + radius * inward - np.asarray(body.position)
+    return radius, body.rotation.T @ centre
 
 
 def geometry_mismatch(geometry: Geometry, problem: ImpactProblem) -> str | None:

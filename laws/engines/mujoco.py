@@ -76,6 +76,7 @@ from lawbench.laws.engines._base import (
     Start,
     elastic_contact,
     engine_options,
+    plane_axes,
     quietly,
     require,
 )
@@ -212,15 +213,8 @@ def _joints(kind: str, axis: np.ndarray, anchor: np.ndarray, centre: np.ndarray)
     if kind == "free":
         return [("free", None, centre)]
     if kind == "planar":
-        first = np.cross(axis, [1.0, 0.0, 0.0])
-        if np.linalg.norm(first) < 0.5:
-            first = np.cross(axis, [0.0, 1.0, 0.0])
-        first /= np.linalg.norm(first)
-        return [
-            ("slide", first, centre),
-            ("slide", np.cross(axis, first), centre),
-            ("hinge", axis, centre),
-        ]
+        first, second = plane_axes(axis)
+        return [("slide", first, centre), ("slide", second, centre), ("hinge", axis, centre)]
     return [(kind, axis, anchor)]
 
 

@@ -75,6 +75,7 @@ from lawbench.laws.engines._base import (
     Force,
     Scene,
     Start,
+    corner,
     engine_options,
     pair_of,
     quietly,
@@ -102,8 +103,6 @@ TUNED = {
     "numSolverIterations": 1000,
     "solverResidualThreshold": 0.0,
 }
-# The radius of the spheres a tuned box touches through, over its smallest half-extent.
-CORNER_RADIUS = 1e-3
 # Bullet clamps the product of two frictions to this.
 MAX_FRICTION = 10.0
 _NO_FORCE = np.zeros(3)
@@ -414,16 +413,12 @@ class _BulletScene(Scene):
     def _corners(self, body: Body) -> list:
         """Radius and position (body frame) of a small sphere at each contact point of ``body``.
 
-        Each touches at its point along the pair's normal; the radius is `CORNER_RADIUS` of the
-        body's smallest half-extent.
+        `corner`'s, flattened.
         """
-        radius = CORNER_RADIUS * min(body.size)
-        R, centre = body.rotation, np.asarray(body.position)
         corners = []
         for pair in self.geometry.pairs:
             if body.name in (pair.a, pair.b):
-                inward = np.asarray(pair.normal) * (1.0 if body.name == pair.a else -1.0)
-                local = R.T @ (np.asarray(pair.point) + radius * inward - centre)
+                radius, local = corner(body, pair)
                 corners += [radius, tuple(local.tolist())]
         return corners
 
