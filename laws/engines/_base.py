@@ -28,11 +28,13 @@ import importlib.util
 import os
 import sys
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, ClassVar
 
 import numpy as np
+import scipy.optimize
 
 from lawbench.core.errors import SolverFailure
 from lawbench.core.geometry import TOLERANCE, Body, ContactPair, Geometry
@@ -280,6 +282,23 @@ class EngineLaw(Law):
         NotApplicable
             For a shape, joint or set of coefficients the engine cannot build.
         """
+
+
+# The least restitution an engine's damping is given: e = 0 needs an infinite damping.
+LEAST_RESTITUTION = 1e-3
+
+
+def damping_for(e: float, released: Callable[[float], float], high: float) -> float:
+    """The damping parameter in ``[0, high]`` whose contact ``released`` leaves at ``e``.
+
+    ``released`` maps the parameter to the restitution of one contact released at zero force
+    (decreasing from 1 at 0). An ``e`` below `LEAST_RESTITUTION` (0 included, which no finite
+    damping reaches) is given that of `LEAST_RESTITUTION`.
+    """
+    if e >= 1.0:
+        return 0.0
+    target = max(e, LEAST_RESTITUTION)
+    return scipy.optimize.brentq(lambda x: released(x) - target, 0.0, high, xtol=1e-14)
 
 
 def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

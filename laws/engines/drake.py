@@ -83,9 +83,11 @@ from lawbench.core.law import LAWS
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.verdicts import Claim, Region
 from lawbench.laws.engines._base import (
+    LEAST_RESTITUTION,
     EngineLaw,
     Scene,
     Start,
+    damping_for,
     elastic_contact,
     engine_options,
     require,
@@ -97,9 +99,6 @@ require("pydrake")
 _DOCS = "Drake documentation, https://drake.mit.edu (MultibodyPlant: contact modeling)"
 # Steps of dt over one period of the stiffest tuned contact.
 STEPS_PER_CONTACT = 50
-# The smallest restitution a tuned contact is given the dissipation of: e = 0 needs an
-# unbounded one.
-LEAST_RESTITUTION = 1e-3
 # The tuned integrator's target accuracy (Drake's relative error measure of the state).
 ACCURACY = 1e-6
 # The tuned stiction tolerance over the largest pre-impact speed: the slip speed below which
@@ -143,17 +142,8 @@ def released_restitution(u: float) -> float:
 
 
 def dissipation_speed(e: float) -> float:
-    """``u = d v0`` whose linear Hunt-Crossley contact leaves at restitution ``e``.
-
-    `released_restitution` inverted; an ``e`` below `LEAST_RESTITUTION` (0 included, which no
-    finite dissipation reaches) is given that of `LEAST_RESTITUTION`.
-    """
-    if e >= 1.0:
-        return 0.0
-    target = max(e, LEAST_RESTITUTION)
-    return scipy.optimize.brentq(
-        lambda u: released_restitution(u) - target, 0.0, 2.0 / target, xtol=1e-14
-    )
+    """``u = d v0`` whose linear Hunt-Crossley contact leaves at restitution ``e``."""
+    return damping_for(e, released_restitution, 2.0 / max(e, LEAST_RESTITUTION))
 
 
 class Drake(EngineLaw):

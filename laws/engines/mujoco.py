@@ -61,7 +61,6 @@ import math
 from types import ModuleType
 
 import numpy as np
-import scipy.optimize
 
 from lawbench.checks.regions import oblique_contacts, option
 from lawbench.core.errors import NotApplicable
@@ -74,6 +73,7 @@ from lawbench.laws.engines._base import (
     Force,
     Scene,
     Start,
+    damping_for,
     elastic_contact,
     engine_options,
     plane_axes,
@@ -88,9 +88,6 @@ _DOCS = "MuJoCo documentation, https://mujoco.readthedocs.io (Computation: soft 
 STEPS_PER_CONTACT = 200
 # The impedance of a tuned contact: the share of its reference acceleration the solver reaches.
 IMPEDANCE = 0.9999
-# The smallest restitution a tuned contact is given the damping of: at e = 0 the damping ratio
-# would be infinite.
-LEAST_RESTITUTION = 1e-3
 # The least damping of the friction of a tuned contact, over sqrt(k): critical damping.
 FRICTION_DAMPING = 2.0
 
@@ -122,17 +119,8 @@ def released_restitution(zeta: float) -> float:
 
 
 def damping_ratio(e: float) -> float:
-    """The damping ratio whose contact, released at zero force, leaves at restitution ``e``.
-
-    `released_restitution` inverted; an ``e`` below `LEAST_RESTITUTION` (0 included, which no
-    finite damping reaches) is given that of `LEAST_RESTITUTION`.
-    """
-    if e >= 1.0:
-        return 0.0
-    target = max(e, LEAST_RESTITUTION)
-    return scipy.optimize.brentq(
-        lambda zeta: released_restitution(zeta) - target, 0.0, 1e6, xtol=1e-14
-    )
+    """The damping ratio whose contact, released at zero force, leaves at restitution ``e``."""
+    return damping_for(e, released_restitution, 1e6)
 
 
 class MuJoCo(EngineLaw):
