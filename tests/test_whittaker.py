@@ -626,3 +626,18 @@ def test_deterministic(problem):
     np.testing.assert_array_equal(first.Pt, second.Pt)
     for key in ("solutions", "formulation", "uniqueness", "coupling"):
         assert first.diagnostics[key] == second.diagnostics[key]
+
+
+def test_the_wall_clock_stop_inside_lemke_ends_the_solve(monkeypatch):
+    """Lemke's failure hands a problem of several contacts to the mode enumeration; the
+    solve's time running out (the guard's stop, raised wherever the law's code runs) ends it."""
+    from lawbench.core.errors import BudgetExceeded
+    from lawbench.core.guards import stopped
+    from lawbench.laws import whittaker
+
+    def out_of_time(*args):
+        raise stopped(0.1)
+
+    monkeypatch.setattr(whittaker, "lemke", out_of_time)
+    with pytest.raises(BudgetExceeded, match="wall-clock guard"):
+        lawbench.solve("whittaker", "rocking_block")

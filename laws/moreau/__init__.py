@@ -149,6 +149,7 @@ from lawbench.laws.moreau.methods import (
     SWEEPS_PER_CONTACT,
     in_turn,
     methods_for,
+    out_of_time,
 )
 from lawbench.numerics import cones
 from lawbench.numerics.gauss_seidel import (
@@ -532,8 +533,8 @@ def _gauss_seidel(
         local_P, diagnostics = solve_polished(
             W, local_q, mu, d + 1, options["tol"], options["polish"]
         )
-    except SolverFailure:
-        if m > 1:
+    except SolverFailure as failure:
+        if m > 1 or out_of_time(failure):
             raise
         # One contact's states decide: its exact one, or the reason the law has none.
         P = _one_contact_or_refuse(G, q, mu)
