@@ -384,7 +384,11 @@ def _lemke_planar(setup: _Setup) -> tuple[np.ndarray | None, dict[str, Any]]:
     except SolverFailure as exc:
         return None, {"lemke": str(exc)}
     z = result.z
-    return np.concatenate([z[:m], z[m : 2 * m] - z[2 * m : 3 * m]]), {"pivots": result.pivots}
+    # The tangential impulse is a difference of pivoted variables, in the cone only to their
+    # rounding: where no normal impulse acts that rounding alone would leave the cone.
+    bound = setup.problem.mu * z[:m]
+    Pt = np.clip(z[m : 2 * m] - z[2 * m : 3 * m], -bound, bound)
+    return np.concatenate([z[:m], Pt]), {"pivots": result.pivots}
 
 
 class Whittaker(Law):
