@@ -28,41 +28,40 @@ This module only gathers the public names; nothing in the package imports it.
 
 import importlib
 
-from lawbench.checks import CHECKS, CheckResult, run_checks
-from lawbench.core.case import CASES, Case, GroundTruth, Reference
-from lawbench.core.contact import ContactProblem, ContactSolution
-from lawbench.core.errors import (
-    BudgetExceeded,
-    InvalidProblem,
-    LawbenchError,
-    LossyExport,
-    NotApplicable,
-    SolverFailure,
-    UnknownName,
-)
-from lawbench.core.law import LAWS, Law
-from lawbench.core.outcome import Outcome
-from lawbench.core.problem import Contact, ImpactProblem
-from lawbench.core.spec import Spec
-from lawbench.core.tags import Tags
-from lawbench.core.trial import Trial, evaluate, solve, solve_batch
-from lawbench.core.verdicts import Claim, Region, Verdict
-
-# Loaded when first asked for: problem files need scipy.sparse (and h5py for HDF5), fitting
-# needs pandas and scipy.optimize, run tables pandas and pyarrow, figures matplotlib; batches
-# are more code than a single solve reads.
+# Every public name is loaded when first asked for, so that importing the package (as the
+# ``lawbench`` program does first, `lawbench.views.program`) loads no numerical library: a
+# single solve loads the core and numpy, problem files scipy.sparse (and h5py for HDF5),
+# fitting pandas and scipy.optimize, run tables pandas and pyarrow, figures matplotlib.
 _LAZY = {
-    "OutcomeBatch": "lawbench.core.batch",
-    "ProblemBatch": "lawbench.core.batch",
-    "load_problem": "lawbench.files.problem_files",
-    "save_problem": "lawbench.files.problem_files",
-    "fit": "lawbench.fitting",
-    "FitResult": "lawbench.fitting",
+    **dict.fromkeys(("CHECKS", "CheckResult", "run_checks"), "lawbench.checks"),
+    **dict.fromkeys(("CASES", "Case", "GroundTruth", "Reference"), "lawbench.core.case"),
+    **dict.fromkeys(("ContactProblem", "ContactSolution"), "lawbench.core.contact"),
+    **dict.fromkeys(
+        (
+            "BudgetExceeded",
+            "InvalidProblem",
+            "LawbenchError",
+            "LossyExport",
+            "NotApplicable",
+            "SolverFailure",
+            "UnknownName",
+        ),
+        "lawbench.core.errors",
+    ),
+    **dict.fromkeys(("LAWS", "Law"), "lawbench.core.law"),
+    "Outcome": "lawbench.core.outcome",
+    **dict.fromkeys(("Contact", "ImpactProblem"), "lawbench.core.problem"),
+    "Spec": "lawbench.core.spec",
+    "Tags": "lawbench.core.tags",
+    **dict.fromkeys(("Trial", "evaluate", "solve", "solve_batch"), "lawbench.core.trial"),
+    **dict.fromkeys(("Claim", "Region", "Verdict"), "lawbench.core.verdicts"),
+    **dict.fromkeys(("OutcomeBatch", "ProblemBatch"), "lawbench.core.batch"),
+    **dict.fromkeys(("load_problem", "save_problem"), "lawbench.files.problem_files"),
+    **dict.fromkeys(("fit", "FitResult"), "lawbench.fitting"),
     "load_run": "lawbench.studies.runfile",
-    "plot_outcome": "lawbench.views.plotting",
-    "plot_path": "lawbench.views.plotting",
-    "plot_profiles": "lawbench.views.plotting",
-    "plot_sweep": "lawbench.views.plotting",
+    **dict.fromkeys(
+        ("plot_outcome", "plot_path", "plot_profiles", "plot_sweep"), "lawbench.views.plotting"
+    ),
     "check_law": "lawbench.studies.conformance",
 }
 
@@ -75,7 +74,9 @@ def __getattr__(name: str) -> object:
 
         return version("lawbench")
     if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value  # asked once
+        return value
     raise AttributeError(f"module 'lawbench' has no attribute {name!r}")
 
 

@@ -2,6 +2,6 @@
 
 import sys
 
-from lawbench.views.cli import program
+from lawbench.views.program import program
 
 sys.exit(program())

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.checks.regions import resting_contact, separating_contact
+from lawbench.checks.regions import lifting_contacts, resting_contact, separating_contact
 from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.core.metric import is_diagonal
@@ -79,6 +79,21 @@ class Newton(Law):
             "contact would lift it (the rocking block's pivot) only a tensile impulse keeps it "
             "down, -5.8 N s on the elastic frictionless block",
             (("rocking_block", "elastic frictionless"),),
+        ),
+        Claim(
+            "impulse_sign",
+            lifting_contacts,
+            _SOURCE,
+            "every closed contact is held at un+ = -e un-, also one that the impulse of another "
+            "lifts (G_ij > 0): holding it down, approaching or not, takes a tensile impulse",
+        ),
+        Claim(
+            "energy_gain",
+            separating_contact | lifting_contacts,
+            "Brogliato 2010, eq. (29); dT = sum Pn_j (1 - e_j) un-_j / 2 for un+ = -e un-",
+            "each contact adds Pn_j (1 - e_j) un-_j / 2 to dT: positive where an approaching "
+            "contact takes a tensile impulse (another's impulse lifts it) or a separating one "
+            "is pushed, so below e = 1 the law can create energy",
         ),
     )
     guarantees = (

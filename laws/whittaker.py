@@ -77,7 +77,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import scipy.optimize
 
-from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.metric import is_diagonal, kinetic_energy
 from lawbench.core.outcome import Outcome
@@ -379,10 +379,16 @@ def _lemke_planar(setup: _Setup) -> tuple[np.ndarray | None, dict[str, Any]]:
     m = setup.m
     try:
         result = lemke(*planar_friction_lcp(setup.problem))
+    except BudgetExceeded:  # the solve's time ran out: no method follows
+        raise
     except SolverFailure as exc:
         return None, {"lemke": str(exc)}
     z = result.z
-    return np.concatenate([z[:m], z[m : 2 * m] - z[2 * m : 3 * m]]), {"pivots": result.pivots}
+    # The tangential impulse is a difference of pivoted variables, in the cone only to their
+    # rounding: where no normal impulse acts that rounding alone would leave the cone.
+    bound = setup.problem.mu * z[:m]
+    Pt = np.clip(z[m : 2 * m] - z[2 * m : 3 * m], -bound, bound)
+    return np.concatenate([z[:m], Pt]), {"pivots": result.pivots}
 
 
 class Whittaker(Law):

@@ -92,6 +92,25 @@ def test_a_contact_that_opens_releases_its_springs():
     assert stored[-1].max() <= 1e-9 * stored.max()
 
 
+def test_a_frictionless_contact_among_frictional_ones_has_no_tangential_force():
+    """A body sliding along x on two walls, one smooth (mu = 0) and one rough (mu = 0.3): the
+    smooth wall's tangential spring stuck, with no cone to bound it, and pushed back with
+    |Pt| = 1.45 where mu Pn = 0. Every rigid law gives it no tangential impulse."""
+    problem = lawbench.ImpactProblem.from_arrays(
+        np.eye(3),
+        [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+        [1.0, -1.0, -1.0],
+        [[1.0, 1.0], [0.0, 0.0], [0.0, 0.0]],
+        e=1.0,
+        mu=[0.0, 0.3],
+    )
+    trial = lawbench.evaluate("compliant", problem)
+    assert trial.outcome.Pt[0] == 0.0
+    assert lawbench.run_checks(trial)["friction_cone"].passed
+    rigid = lawbench.solve("moreau", problem)
+    np.testing.assert_allclose(trial.outcome.Pt, rigid.Pt, rtol=1e-6, atol=1e-8)
+
+
 def test_several_spatial_contacts_at_once():
     """The billiard shot: cue-ball and ball-table contacts, both frictional, in 3D."""
     trial = lawbench.evaluate("compliant", "billiard", {"tol": 1e-8})

@@ -13,6 +13,7 @@ import contextlib
 import io
 import itertools
 import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -105,3 +106,39 @@ def test_environment_faults_end_in_one_line_and_a_documented_code(tmp_path_facto
             assert Path(out + ".json").is_symlink() and Path(f"{out}-target.json").is_file()
 
     check()
+
+
+@pytest.mark.parametrize("kib", [60_000, 200_000])
+def test_an_address_space_too_small_to_start_is_one_line_and_exit_4(kib):
+    """Under ``ulimit -v`` numpy's and scipy's start failed in native code: a traceback at 60
+    MB (a library that cannot be mapped), OpenBLAS looping without end at 200 MB. The program
+    checks the room first and says what is missing in one line, exit 4."""
+    done = subprocess.run(
+        ["bash", "-c", f"ulimit -v {kib}; exec {sys.executable} -m lawbench list"],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert done.returncode == 4, done.stderr[-1000:]
+    assert done.stderr.startswith("lawbench: out of memory: the address-space limit")
+    assert len(done.stderr.splitlines()) == 1 and done.stdout == ""
+
+
+class _Unmappable:
+    """A finder under which the command line cannot be loaded: its library does not map."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name == "lawbench.views.cli.main":
+            raise ImportError("libopenblas.so: failed to map segment from shared object")
+        return None
+
+
+def test_a_library_that_cannot_be_mapped_at_start_is_one_line_and_exit_4(monkeypatch, capsys):
+    from lawbench.views.program import program
+
+    monkeypatch.delitem(sys.modules, "lawbench.views.cli.main")
+    monkeypatch.setattr(sys, "meta_path", [_Unmappable(), *sys.meta_path])
+    assert program() == 4
+    err = capsys.readouterr().err
+    assert err.startswith("lawbench: out of memory while starting (ImportError: libopenblas.so")
+    assert len(err.splitlines()) == 1

@@ -345,3 +345,46 @@ def test_an_answer_that_breaks_a_promise_is_a_solver_failure_never_ok():
     trial = lawbench.evaluate(broken(pulls), ball())
     with pytest.raises(SolverFailure, match="admissible fails where it must hold"):
         _refuse_broken_promises(trial, run_checks(trial))
+
+
+FIRST_SOLVE_STOPPED = """
+import time
+
+import lawbench
+from lawbench.core.errors import BudgetExceeded
+from lawbench.core.trial import make_trial
+
+lawbench.LAWS.get("moreau")
+for seconds in (0.02, 0.05, 0.1):
+    start = time.monotonic()
+    try:
+        make_trial("moreau", "sphere_wall", max_seconds=seconds)
+    except BudgetExceeded:
+        continue
+    if time.monotonic() - start > seconds + 0.05:
+        raise SystemExit(f"answered past its bound of {seconds} s")
+print(lawbench.solve("moreau", "sphere_wall").v_plus.tolist())
+"""
+
+
+def test_a_first_solve_stopped_while_numba_loads_leaves_the_process_able_to_solve():
+    """The first frictional solve at one contact imports numba and loads Gauss-Seidel's
+    compiled kernel: stopped there by the wall-clock guard, numba was left half-imported (every
+    later solve an AttributeError or KeyError), or the stop was swallowed and the answer came
+    past its bound. The guard now rings once numba is whole: each stopped solve is a budget,
+    and the next one answers."""
+    done = subprocess.run(
+        [sys.executable, "-c", FIRST_SOLVE_STOPPED], capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+
+
+def test_an_alarm_waits_for_held_code_and_rings_as_it_ends():
+    finished = []
+    with pytest.raises(BudgetExceeded, match=WALL_CLOCK):
+        with alarm(0.05):
+            with guards.held():
+                time.sleep(0.2)
+                finished.append(True)
+            time.sleep(5)
+    assert finished == [True]

@@ -130,6 +130,21 @@ def test_the_time_budget_ends_auto_without_a_second_method():
     assert failure.value.budget == "max_seconds"
 
 
+def test_the_wall_clock_stop_ends_a_one_contact_solve_without_its_exact_state(monkeypatch):
+    """At one contact a failed Gauss-Seidel gives way to the contact's exact state, but the
+    solve's time running out (here the guard's stop) is no failure of the method: it ends the
+    solve, which else answered past its bound."""
+    from lawbench.core.guards import stopped
+    from lawbench.laws import moreau
+
+    def out_of_time(*args):
+        raise stopped(0.1)
+
+    monkeypatch.setattr(moreau, "solve_polished", out_of_time)
+    with pytest.raises(BudgetExceeded, match="wall-clock guard"):
+        MOREAU.resolve(lawbench.CASES.get("sphere_wall").build())
+
+
 def test_auto_solves_anitescus_relaxation_by_the_fixed_point():
     """Gauss-Seidel solves Coulomb's law only: auto gives the relaxation to the fixed point,
     where an explicit ``method=nsgs`` is refused."""

@@ -437,3 +437,15 @@ def test_a_huge_friction_coefficient_gives_the_sticking_answer():
         huge = lawbench.solve("moreau", "falling_rod", {"method": method}, mu=1e300)
         np.testing.assert_allclose(huge.v_plus, sticking.v_plus, rtol=1e-12)
     assert huge.diagnostics["formulation"].endswith("then the contact's exact state")
+
+
+def test_impulses_that_change_the_velocities_only_through_their_rounding_are_refused():
+    """One coordinate and a spatial contact: both tangential directions are the normal's, so
+    Coulomb's states hold impulses of any size along the dependence. The contact's exact
+    state was impulses of 3e16 whose velocity, their rounding, left the contact at
+    un+ = 1 = -un- with e = 0.5, FC3D error zero, status ok."""
+    problem = lawbench.ImpactProblem.from_arrays(
+        [[1.0]], [[1.0]], [-1.0], [[0.5, 1.0]], e=0.5, mu=1000.0
+    )
+    with pytest.raises(lawbench.SolverFailure, match="only through their cancellation"):
+        lawbench.solve("moreau", problem)

@@ -75,6 +75,22 @@ def test_a_law_finding_covers_a_user_problem_through_its_region():
     assert "separates before the impact" in results["impulse_sign"].claim.region.text
 
 
+def test_newtons_tensile_impulse_and_energy_gain_where_one_contact_lifts_another():
+    """Both contacts approach, and an impulse at the first lifts the second (G_01 = 1 > 0):
+    Newton's law holds the second at un+ = -e un- with a tensile impulse, and with e = (1, 0)
+    that impulse adds to the energy (dT = sum Pn_j (1 - e_j) un-_j / 2 > 0). The law's theory,
+    where the verdicts were a numerical failure and an unexplained gain (and ``lawbench
+    solve`` refused the answer, exit 4)."""
+    problem = lawbench.ImpactProblem.from_arrays(
+        np.eye(2), [[1.0, 1.0], [0.0, 1.0]], [-1.0, 0.99], e=[1.0, 0.0]
+    )
+    results = lawbench.run_checks(lawbench.evaluate("newton", problem))
+    for check in ("impulse_sign", "energy_gain"):
+        assert results[check].passed is False
+        assert results[check].verdict == Verdict.LAW_PROPERTY
+        assert "lifts the other" in results[check].claim.region.text
+
+
 @pytest.mark.parametrize("law", sorted(lawbench.LAWS.names()))
 def test_a_separating_contact_is_treated_by_a_stated_rule(law):
     """Every law states how it treats a closed contact that separates before the impact, and

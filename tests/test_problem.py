@@ -4,6 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+import scipy.sparse
 
 import lawbench
 from lawbench import Contact, ImpactProblem, InvalidProblem
@@ -37,11 +38,29 @@ def two_balls(**changes):
         ({"gaps": np.array([-1.0])}, r"gaps\[0\] = -1"),
         ({"Wt": np.ones((2, 3))}, "Wt has shape"),
         ({"bodies": {"ball": (0, 5)}}, r"bodies\['ball'\]"),
+        # Unset where a number is needed: the laws compared it with numbers (a TypeError).
+        ({"contacts": [Contact(mu=None)]}, r"contacts\[0\]\.mu = None: must be a number"),
+        # Integers beyond double precision: converting them raised an OverflowError.
+        ({"contacts": [Contact(e=10**400)]}, r"contacts\[0\]\.e: an integer of 1329 bits"),
+        ({"v": [10**400, 0.0]}, "v: not an array of numbers"),
+        ({"M": [[10**400, 0.0], [0.0, 1.0]]}, "M: not an array of numbers"),
+        # A sparse M of 1e12 columns: densified (a MemoryError) before its shape was read.
+        ({"M": scipy.sparse.csr_array((2, 10**12))}, r"M has shape \(2, 1000000000000\)"),
     ],
 )
 def test_bad_fields_are_refused_by_name(changes, message):
     with pytest.raises(InvalidProblem, match=message):
         two_balls(**changes)
+
+
+def test_many_contacts_are_checked_as_one_table_with_the_same_refusals():
+    """Beyond eight distinct contacts the fields are read as one table: an unset mu there
+    passed as a number."""
+    m, mu = 10, [0.1] * 9 + [None]
+    with pytest.raises(InvalidProblem, match=r"contacts\[9\]\.mu = None"):
+        ImpactProblem.from_arrays(np.eye(m), np.eye(m), -np.ones(m), np.eye(m), mu=mu)
+    unset = ImpactProblem.from_arrays(np.eye(m), np.eye(m), -np.ones(m), e_newton=[None] * m)
+    assert unset.restitution("kinematic").tolist() == [1.0] * m
 
 
 def test_invalid_problem_is_a_value_error():

@@ -139,6 +139,44 @@ def test_bad_files_exit_2_with_one_line_naming_the_field(tmp_path, name, content
 
 
 @pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ({**GOOD, "contacts": [{"e": 10**400}]}, r"contacts\[0\]\.e: an integer of 1329 bits"),
+        ({**GOOD, "M": [[10**400]]}, "field 'M' holds a value that is not a number"),
+        ({**GOOD, "contacts": [{"mu": None}]}, r"contacts\[0\]\.mu = None: must be a number"),
+    ],
+)
+def test_json_numbers_no_double_holds_and_unset_coefficients_are_refused(
+    tmp_path, capsys, content, message
+):
+    """JSON integers have no bound: one of 400 digits was an OverflowError, and a null mu a
+    TypeError in the law, each an internal error of ``lawbench solve``."""
+    from lawbench.views import cli
+
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps(content))
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        load_problem(path)
+    assert cli.main(["solve", "moreau", "--problem", str(path)]) == 2
+    assert len(capsys.readouterr().err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("sparse", [False, True], ids=["dense", "marked sparse"])
+def test_a_matrix_claiming_a_billion_columns_is_refused_before_it_is_allocated(tmp_path, sparse):
+    """A few bytes of an NPZ claimed M to be 40 x 1e9 (298 GiB dense): a MemoryError."""
+    path = tmp_path / "ok.npz"
+    save_problem(lawbench.CASES.get("ball_chain").build(n=40), path)
+    arrays = dict(np.load(path, allow_pickle=False))
+    arrays["M.shape"] = np.array([40, 10**9])
+    if sparse:
+        arrays["sparse"] = np.array(True)
+    np.savez(tmp_path / "bad.npz", **arrays)
+    message = r"M has shape \(40, 1000000000\)" if sparse else "claims 40 x 1000000000 entries"
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        load_problem(tmp_path / "bad.npz")
+
+
+@pytest.mark.parametrize(
     ("name", "fclib"),
     [("bc.npz", None), ("bc.json", None), ("bc.h5", None), ("l.h5", "local"), ("g.h5", "global")],
 )

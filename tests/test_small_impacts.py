@@ -169,3 +169,17 @@ def test_an_outcome_is_frozen_and_replaced_field_by_field():
     changed = dataclasses.replace(outcome, status="ambiguous")
     assert changed.status == "ambiguous" and changed.T_plus == outcome.T_plus
     assert changed.diagnostics == outcome.diagnostics
+
+
+def test_an_lcp_without_a_solution_is_never_polished_into_one():
+    """Two closed contacts along opposite normals, one approaching (e = 1), the other
+    separating: restituting the first asks the second to approach, and the LCP has no
+    solution. clarabel certifies it (its QP is unbounded); its last iterate, impulses of
+    1e15 whose slacks cancel to within their rounding, passed the polish as an answer with a
+    contact left approaching, status ok."""
+    problem = ImpactProblem.from_arrays(np.eye(2), [[1.0, -1.0], [1.0, -1.0]], [-1.0, 0.3], e=1.0)
+    with pytest.raises(lawbench.SolverFailure, match="the LCP has no solution"):
+        lawbench.solve("moreau", problem)
+    q = problem.un + problem.un.clip(max=0.0)
+    with pytest.raises(lawbench.SolverFailure, match="DualInfeasible"):
+        solve_lcp(problem.delassus, q)

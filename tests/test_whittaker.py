@@ -626,3 +626,36 @@ def test_deterministic(problem):
     np.testing.assert_array_equal(first.Pt, second.Pt)
     for key in ("solutions", "formulation", "uniqueness", "coupling"):
         assert first.diagnostics[key] == second.diagnostics[key]
+
+
+def test_the_wall_clock_stop_inside_lemke_ends_the_solve(monkeypatch):
+    """Lemke's failure hands a problem of several contacts to the mode enumeration; the
+    solve's time running out (the guard's stop, raised wherever the law's code runs) ends it."""
+    from lawbench.core.errors import BudgetExceeded
+    from lawbench.core.guards import stopped
+    from lawbench.laws import whittaker
+
+    def out_of_time(*args):
+        raise stopped(0.1)
+
+    monkeypatch.setattr(whittaker, "lemke", out_of_time)
+    with pytest.raises(BudgetExceeded, match="wall-clock guard"):
+        lawbench.solve("whittaker", "rocking_block")
+
+
+def test_lemkes_rounding_never_leaves_a_contact_outside_its_cone():
+    """Three contacts along one normal, all separating: no impulse acts, but Lemke's pivots
+    left a tangential impulse of 5.5e-17 at a contact whose normal impulse is zero, outside
+    its cone (the check's verdict a numerical failure, and ``lawbench solve`` refused it)."""
+    tangents = [[0.57, -0.9, 0.51], [-0.97, -0.05, -0.15], [0.9, -0.9, 0.05]]
+    problem = ImpactProblem.from_arrays(
+        np.diag([0.0073, 0.0098, 0.0116]),
+        [[1.0, 1.0, 1.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
+        [1.0, -2.0, -10.0],
+        tangents,
+        e=1.0,
+        mu=0.3,
+    )
+    trial = lawbench.evaluate("whittaker", problem)
+    assert trial.outcome.diagnostics["formulation"] == "Lemke LCP"
+    assert lawbench.run_checks(trial, checks=["friction_cone"])["friction_cone"].passed

@@ -31,6 +31,7 @@ __all__ = [
     "example",
     "frictional",
     "frictionless",
+    "lifting_contacts",
     "nonlinear_springs",
     "oblique_contacts",
     "option",
@@ -63,6 +64,28 @@ def _resting(trial: Any) -> bool:
 resting_contact = Region(
     "a closed contact at rest before the impact (un- = 0), coupled to one that approaches",
     _resting,
+)
+
+
+def _lifting(trial: Any) -> bool:
+    problem = trial.problem
+    closed = np.asarray(problem.closed)
+    if closed.sum() < 2:
+        return False
+    G = problem.delassus
+    if is_sparse(G):
+        G = G.tocoo()
+        rows, columns, values = G.row, G.col, G.data
+    else:
+        rows, columns = np.nonzero(np.asarray(G))
+        values = np.asarray(G)[rows, columns]
+    between = closed[rows] & closed[columns] & (rows != columns)
+    return bool((values[between] > COUPLING * np.abs(values).max()).any())
+
+
+lifting_contacts = Region(
+    "two closed contacts where an impulse at one lifts the other (Delassus entry G_ij > 0)",
+    _lifting,
 )
 
 frictional = Region("some contact has friction", lambda trial: trial.problem.frictional)

@@ -12,7 +12,9 @@ calls `end_process_when_stuck` (``lawbench solve``, ``lawbench check``), a watch
 ends the process with one line and exit code 4 `LAST_RESORT_S` seconds after an alarm's
 deadline. The watchdog runs while the native call releases the interpreter's lock, as numpy's
 linear algebra and every blocking system call do; a native loop that holds the lock can only
-be stopped from another process.
+be stopped from another process. Code that an exception would leave half done for the rest of
+the process (a compiler's import and first compilation) runs `held`: an alarm that rings
+meanwhile rings again as it ends.
 
 `user_interrupts` counts the SIGINTs the user sends while lawbench watches them, so that a
 `KeyboardInterrupt` raised by a law's own code (a failure of that law) is told apart from the
@@ -82,6 +84,9 @@ def alarm(seconds: float | None) -> Iterator[None]:
     outer_first = 0 < outer_left <= seconds
 
     def ring(signum: int, frame: Any) -> None:
+        if _Held.depth:
+            _Held.rang = True
+            return
         if outer_first and callable(outer):
             outer(signum, frame)
         raise stopped(seconds)
@@ -98,6 +103,37 @@ def alarm(seconds: float | None) -> Iterator[None]:
             # An outer deadline already past rings at once, in the outer alarm's own words.
             left = outer_left - (time.monotonic() - start)
             signal.setitimer(signal.ITIMER_REAL, max(left, 1e-6))
+
+
+class _Held:
+    """How many `held` blocks are open, and whether an alarm rang inside them."""
+
+    depth = 0
+    rang = False
+
+
+@contextmanager
+def held() -> Iterator[None]:
+    """Run the enclosed code whole: an `alarm` that rings inside it rings again as it ends.
+
+    For code that a stop half-way would leave broken for the rest of the process: numba's
+    import, or its first compilation of a kernel, stopped by an exception, fails on every later
+    call (a type registered twice, a library with no compiled object). Blocks nest; the alarm
+    rings once the outermost ends. The signal cannot be blocked instead: the timer's signal goes
+    to the process, and a thread of a numerical library that does not block it receives it.
+    Outside the main thread, where no alarm rings, nothing is held.
+    """
+    if not in_main_thread():
+        yield
+        return
+    _Held.depth += 1
+    try:
+        yield
+    finally:
+        _Held.depth -= 1
+        if not _Held.depth and _Held.rang:
+            _Held.rang = False
+            signal.setitimer(signal.ITIMER_REAL, 1e-6)
 
 
 # Seconds past an alarm's deadline before the watchdog of `end_process_when_stuck` ends the

@@ -60,14 +60,19 @@ def as_array(value: Any) -> np.ndarray:
 
 
 def checked_matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
-    """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`."""
+    """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`.
+
+    A sparse ``value`` is densified once its shape is ``shape``: it may claim a billion columns.
+    """
     if is_sparse(value):
+        if value.shape != shape:
+            raise InvalidProblem(f"{name} has shape {value.shape}, expected {shape}")
         value = value.toarray()
     try:
         if np.iscomplexobj(value):
             raise InvalidProblem(f"{name}: complex numbers; a problem holds real ones")
         array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:  # OverflowError: an int of 10**400
         if isinstance(exc, InvalidProblem):
             raise
         raise InvalidProblem(f"{name}: not an array of numbers ({exc})") from None
@@ -93,10 +98,13 @@ def read_only_finite(name: str, array: np.ndarray) -> np.ndarray:
 def checked_sparse_matrix(name: str, value: object, shape: tuple[int, int]) -> Any:
     """Return ``value`` as a read-only CSC array of ``shape``, or raise `InvalidProblem`.
 
-    The checks cost O(nnz): only the stored entries are read.
+    The checks cost O(nnz): only the stored entries are read, and a sparse ``value``'s shape
+    before anything of its size is made (it may claim a billion columns).
     """
     import scipy.sparse
 
+    if is_sparse(value) and value.shape != shape:
+        raise InvalidProblem(f"{name} has shape {value.shape}, expected {shape}")
     try:
         matrix = scipy.sparse.csc_array(value, dtype=float, copy=True)
     except (TypeError, ValueError) as exc:

@@ -64,7 +64,13 @@ CHECKED_ONE_BY_ONE = 8
 
 def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
     """Raise `InvalidProblem` unless ``low <= value <= high`` (``high`` None: unbounded)."""
-    if not math.isfinite(value):
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:  # an integer beyond the largest double (10**400)
+        raise InvalidProblem(
+            f"{label}: an integer of {int(value).bit_length()} bits, beyond double precision"
+        ) from None
+    if not finite:
         raise InvalidProblem(f"{label} = {value}: must be a finite number")
     if value < low or (high is not None and value > high):
         bounds = f"in [{low:g}, {high:g}]" if high is not None else f">= {low:g}"
@@ -120,7 +126,9 @@ class Contact:
         for name, low, high, positive in CONTACT_RANGES:
             value = getattr(self, name)
             if value is None:
-                continue
+                if name in _UNSET_ALLOWED:
+                    continue
+                raise InvalidProblem(f"{label}.{name} = None: must be a number")
             _check_range(f"{label}.{name}", value, low, high)
             if positive and value == 0.0:
                 raise InvalidProblem(f"{label}.{name} = 0: must be > 0")
@@ -134,6 +142,8 @@ class Contact:
 
 
 CONTACT_FIELDS = frozenset(f.name for f in dataclasses.fields(Contact))
+# The fields that may be None (unset): the overrides of e and Jia's ratio.
+_UNSET_ALLOWED = frozenset(f.name for f in dataclasses.fields(Contact) if f.default is None)
 # One coefficient for every contact, and what a coefficient may be.
 _SCALAR = (int, float, str)
 _NUMBER = (int, float, np.number)
@@ -141,6 +151,7 @@ _CHECKED_FIELDS = operator.attrgetter(*(name for name, *_ in CONTACT_RANGES))
 _LOWS = np.array([low for _, low, _, _ in CONTACT_RANGES])
 _HIGHS = np.array([math.inf if high is None else high for _, _, high, _ in CONTACT_RANGES])
 _POSITIVE = np.array([positive for *_, positive in CONTACT_RANGES])
+_MAY_BE_UNSET = np.array([name in _UNSET_ALLOWED for name, *_ in CONTACT_RANGES])
 
 
 def _check_contacts(contacts: tuple[Contact, ...]) -> Contact | None:
@@ -185,7 +196,7 @@ def _rows_out_of_range(contacts: list[Contact], indices: list[int]) -> list[int]
     missing = np.equal(table, None)
     try:
         values = np.where(missing, 1.0, table).astype(float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return indices
     inside = (
         np.isfinite(values)
@@ -193,7 +204,7 @@ def _rows_out_of_range(contacts: list[Contact], indices: list[int]) -> list[int]
         & (values <= _HIGHS)
         & ~(_POSITIVE & (values == 0.0))
     )
-    bad = ~(inside | missing).all(axis=1)
+    bad = ~np.where(missing, _MAY_BE_UNSET, inside).all(axis=1)
     return [indices[row] for row in np.flatnonzero(bad)]
 
 
@@ -297,7 +308,7 @@ class ImpactProblem:
         # once into the instance (the dataclass is frozen).
         try:
             v = np.array(v, dtype=float, ndmin=1)
-        except (TypeError, ValueError) as exc:
+        except (TypeError, ValueError, OverflowError) as exc:
             raise InvalidProblem(f"v: not an array of numbers ({exc})") from None
         n = v.shape[0] if v.ndim == 1 else -1
         if n < 1:

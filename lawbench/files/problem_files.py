@@ -55,6 +55,9 @@ FORMAT, VERSION = "lawbench-problem", 1
 MATRICES = ("M", "Wn", "Wt", "v", "gaps")
 # A matrix is stored as CSR when at most this share of its entries is non-zero.
 SPARSE_SHARE = 0.25
+# The most entries a matrix stored as CSR in a file not marked sparse may claim, read dense:
+# those of a file of MAX_BYTES in doubles.
+DENSE_MAX = MAX_BYTES // 8
 CONTACT_FIELDS = tuple(Contact.__dataclass_fields__)
 
 
@@ -105,7 +108,7 @@ def from_dict(data: Mapping[str, Any], where: str = "problem") -> ImpactProblem:
             continue
         try:
             np.asarray(value, dtype=float)
-        except (ValueError, TypeError):
+        except (ValueError, TypeError, OverflowError):  # OverflowError: an integer of 10**400
             raise InvalidProblem(
                 f"{where}: field {name!r} holds a value that is not a number"
             ) from None
@@ -326,9 +329,23 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> _Re
                 raise InvalidProblem(
                     f"{where}: field {name!r}: its sparse index arrays are corrupt ({exc})"
                 ) from None
-            data[name] = matrix if sparse else matrix.toarray()
+            data[name] = matrix if sparse else _dense(matrix, name, where)
             storage.append((name, "compressed rows"))
     return _Read(data, tuple(storage), where)
+
+
+def _dense(matrix: scipy.sparse.csr_matrix, name: str, where: Path) -> np.ndarray:
+    """``matrix`` as an array, once the shape it claims has at most `DENSE_MAX` entries.
+
+    A few bytes of a file can claim a billion columns: refused before they are allocated.
+    """
+    rows, columns = matrix.shape
+    if rows * columns > DENSE_MAX:
+        raise InvalidProblem(
+            f"{where}: field {name!r} claims {rows} x {columns} entries, more than the "
+            f"{DENSE_MAX} read dense from a file not marked sparse"
+        )
+    return matrix.toarray()
 
 
 def _write_npz(data: dict[str, Any], path: Path) -> None:

@@ -43,7 +43,10 @@ stationary above ``tol``, Newton's method on the contact states they show
 
 The per-contact kernel and the sweep are compiled by numba at the first solve where it is
 installed (``pip install 'lawbench[fast]'``, `compiled`); the same functions run as plain
-Python without it.
+Python without it. numba's import and each call of a compiled kernel (its compilation or
+cache load the first time) run whole (`lawbench.core.guards.held`): stopped half-way by the
+solve's wall-clock alarm, numba fails on every later call in the process; a compiled kernel
+runs no Python, where the alarm's handler cannot run anyway.
 ``W`` may be dense or scipy.sparse: it is held in compressed rows, so a sweep costs time
 proportional to its non-zero entries.
 """
@@ -52,6 +55,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
@@ -59,6 +63,7 @@ import numpy as np
 import scipy.sparse
 
 from lawbench.core.errors import SolverFailure
+from lawbench.core.guards import held
 from lawbench.core.law import current_budget
 from lawbench.core.mechanics import fc3d_error, project
 from lawbench.numerics import cones
@@ -74,7 +79,11 @@ def _kernel(function: _F) -> _F:
     return function
 
 
-@functools.cache
+def _whole(fast: bool) -> AbstractContextManager[None]:
+    """`held` around a compiled kernel's call; nothing around plain Python, which may stop."""
+    return held() if fast else nullcontext()
+
+
 def compiled() -> bool:
     """Compile the kernels with numba, once, where it is installed; whether they are compiled.
 
@@ -82,6 +91,13 @@ def compiled() -> bool:
     process 0.25 s and 55 MB, and most processes that load Moreau's law never sweep. The module's
     names are bound to the compiled functions, which find each other there when they compile.
     """
+    with held():
+        return _compile()
+
+
+@functools.cache
+def _compile() -> bool:
+    """`compiled`'s work, done once."""
     try:
         import numba
     except ImportError:  # the optional extra 'fast' is not installed: plain Python
@@ -335,9 +351,9 @@ def one_contact(G: np.ndarray, q: np.ndarray, mu: float) -> np.ndarray | None:
     the law (Coulomb's law with kinematic restitution can have no solution when the normal
     and tangential directions are strongly coupled, as Painlevé's examples).
     """
-    compiled()
     G = np.asarray(G, dtype=float)
-    P = _in_a_state(G, inverses(G[None])[0], np.asarray(q, dtype=float), mu, np.zeros(q.size))
+    with _whole(compiled()):
+        P = _in_a_state(G, inverses(G[None])[0], np.asarray(q, dtype=float), mu, np.zeros(q.size))
     return P if P.size else None
 
 
@@ -435,7 +451,7 @@ def solve_nsgs(
     BudgetExceeded
         When the solve's budget (steps: sweeps, or seconds) runs out first.
     """
-    compiled()
+    fast = compiled()
     m, size = len(mu), dim
     W = scipy.sparse.csr_matrix(W, dtype=float)
     if not W.has_canonical_format or not W.data.all():
@@ -444,14 +460,16 @@ def solve_nsgs(
         W.eliminate_zeros()
     local_q = np.ascontiguousarray(q, dtype=float)
     mu = np.ascontiguousarray(mu, dtype=float)
-    blocks = _blocks(W.indptr, W.indices, W.data, size)
+    with _whole(fast):
+        blocks = _blocks(W.indptr, W.indices, W.data, size)
     inverse = inverses(blocks)
     P = np.zeros(m * size) if start is None else np.array(start, dtype=float)
     spend, sweeps, gate, error, note = current_budget(), 0, tol, np.inf, ""
     reference, reference_sweep = np.inf, 0
     while True:
         spend.step("Gauss-Seidel sweeps", note)
-        change = _sweep(W.indptr, W.indices, W.data, blocks, inverse, local_q, mu, P)
+        with _whole(fast):
+            change = _sweep(W.indptr, W.indices, W.data, blocks, inverse, local_q, mu, P)
         sweeps += 1
         light = np.sqrt(change) / max(float(np.linalg.norm(P)), TINY)
         if light <= gate or sweeps % CHECK_EVERY == 0:

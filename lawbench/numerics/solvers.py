@@ -41,6 +41,8 @@ ENUMERATION_MAX = 6
 SPARSE_SIZE = 64
 # Relative violation of z >= 0 and w >= 0 accepted as rounding.
 COMPLEMENTARITY = 1e-10
+# clarabel's certificates that a QP has no solution: for an LCP's QP, that the LCP has none.
+NO_SOLUTION = frozenset({"PrimalInfeasible", "DualInfeasible"})
 
 
 @dataclass(frozen=True)
@@ -445,7 +447,18 @@ def project_on_cone(
 def _finish(
     G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool
 ) -> LCPResult:
-    """Polish clarabel's answer; a status other than 'Solved' is accepted only when polished."""
+    """Polish clarabel's answer; a status other than 'Solved' is accepted only when polished.
+
+    An infeasibility certificate is never polished: the LCP then has no solution (its QP is
+    unbounded, as where two closed contacts push along opposite normals and the restitution
+    of one asks the other to approach), and clarabel's last iterate, impulses of 1e15 whose
+    slacks cancel within their rounding, would pass for one.
+    """
+    if result.status in NO_SOLUTION:
+        raise SolverFailure(
+            f"clarabel status {result.status} after {result.iterations} iterations: the LCP has "
+            "no solution"
+        )
     z = np.maximum(z, 0.0)
     exact = polish(G, q, z) if refine and np.isfinite(z).all() else None
     if exact is not None:

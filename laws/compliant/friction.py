@@ -174,7 +174,8 @@ class FrictionalIntegration(Integration):
         cone_rate = self.cone * np.where(Fn > 0, Fn_rate, 0.0)
         along = np.einsum("...jd,...jd->...j", direction, ut)
         lam = along - cone_rate
-        s_rate = ut * closed[:, None]
+        # A contact without friction has no tangential spring: its stretch stays zero.
+        s_rate = ut * (closed & (self.mu > 0))[:, None]
         # The sliders' power, ``mu Fn lam`` (J per unit of scaled time).
         slid = np.where(slipping, radius * self.kt_scaled * lam * self.L, 0.0).sum(axis=-1)
         if slipping.any():

@@ -21,7 +21,9 @@ their integration are in `lawbench.laws.jia.dynamics`.
   same stiffness increase at each of its ends of compression; a contact whose spring empties
   leaves the active set, and returns when its gap rate turns negative (no stiffness change on
   either event). The outcome depends on stiffness ratios only, taken from the contacts'
-  ``stiffness``; the springs are linear, the contacts' ``exponent`` is not read. The paper
+  ``stiffness``; the springs are linear, the contacts' ``exponent`` is not read, and contacts
+  of different exponents are refused: the ratio of a stiffness in N/m to one in N/m^1.5
+  depends on the unit of length, and so would the answer. The paper
   states it for chains of balls (a ball on a ball on the ground); the equations need only the
   Delassus matrix, which couples the contacts of any system. With friction (the talk's part
   III, simultaneous impacts with friction and compliance: the cue, the billiard ball and the
@@ -64,6 +66,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.checks.regions import nonlinear_springs
+from lawbench.core.errors import NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.core.metric import is_diagonal
 from lawbench.core.outcome import Outcome
@@ -169,6 +172,7 @@ class Jia(Law):
 def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str, Any]) -> Outcome:
     """Integrate Jia's springs; ``d`` tangential directions per contact (0: frictionless)."""
     m = problem.m
+    _refuse_mixed_exponents(problem)
     eta0_sq = np.array([c.tangential_ratio for c in problem.contacts])
     stiffness = np.array([c.stiffness for c in problem.contacts])
     mu = problem.mu if d else np.zeros(m)
@@ -216,6 +220,22 @@ def _integrate(problem: ImpactProblem, d: int, e: np.ndarray, options: dict[str,
             Pn = Pn + stop
             diagnostics["plastic_stop"] = float(stop.max())
     return Outcome.from_impulses(problem, Pn, Pt, diagnostics=diagnostics, path=path)
+
+
+def _refuse_mixed_exponents(problem: ImpactProblem) -> None:
+    """Refuse contacts whose force exponents differ: their stiffness ratios have a unit.
+
+    The springs are linear and only the ratios of the contacts' stiffnesses are read; with one
+    exponent those ratios are numbers, with two (1 and 1.5: N/m against N/m^1.5) they depend
+    on the unit of length, and so would the outcome.
+    """
+    exponents = sorted({c.exponent for c in problem.contacts})
+    if len(exponents) > 1:
+        raise NotApplicable(
+            f"jia: the contacts' force exponents differ ({', '.join(f'{x:g}' for x in exponents)}):"
+            " the ratios of their stiffnesses, which Jia's linear springs read, would depend on "
+            "the unit of length"
+        )
 
 
 def _path(impact: SpringImpact) -> dict[str, np.ndarray]:

@@ -58,6 +58,15 @@ def bounded(options: dict[str, Any], method: str, m: int) -> Iterator[None]:
         budget.max_steps, budget.steps = saved
 
 
+def out_of_time(failure: SolverFailure) -> bool:
+    """Whether ``failure`` is the solve's time running out, which no other method may follow.
+
+    The wall-clock guard's stop (`lawbench.core.guards.stopped`) and ``max_seconds`` end the
+    solve; a method's own step bound (``max_steps``) hands the problem on.
+    """
+    return isinstance(failure, BudgetExceeded) and failure.budget != "max_steps"
+
+
 def in_turn(
     solvers: dict[str, Callable[[], tuple[np.ndarray, dict[str, Any]]]],
     methods: tuple[str, ...],
@@ -83,8 +92,7 @@ def in_turn(
                 P, diagnostics = solvers[method]()
             break
         except SolverFailure as failure:
-            timed_out = isinstance(failure, BudgetExceeded) and failure.budget != "max_steps"
-            if method == methods[-1] or timed_out:
+            if method == methods[-1] or out_of_time(failure):
                 if failures:
                     failure.args = (f"{failure} (after {'; '.join(failures)})",)
                 raise

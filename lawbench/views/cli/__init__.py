@@ -6,6 +6,7 @@ Exit codes: 0 done; 2 bad usage or invalid input; 3 the law does not apply; 4 so
 on stderr, never a traceback.
 """
 
-from lawbench.views.cli.main import build_parser, main, program
+from lawbench.views.cli.main import build_parser, main
+from lawbench.views.program import program
 
 __all__ = ["build_parser", "main", "program"]

@@ -256,11 +256,6 @@ def main(argv: Sequence[str] | None = None, *, own_process: bool = False) -> int
     return code
 
 
-def program() -> int:
-    """The ``lawbench`` program: `main` on this process's arguments, owning the process."""
-    return main(own_process=True)
-
-
 def _os_error(exc: OSError) -> int:
     """Say what the system refused, in one line; exit 4 out of room, 2 for anything else."""
     where = f"{exc.filename}: " if exc.filename is not None else "the output: "
