@@ -357,11 +357,12 @@ class KineticMetric:
             Naming the first such contact.
         """
         sparse = is_sparse(W)
-        squares = W.multiply(W) if sparse else W * W
-        # The squared Frobenius norm of W bounds its largest squared column: one sum settles
-        # the usual case.
-        if normal.min() > 1e-12 * self.largest_inverse * squares.sum():
+        # The squared Frobenius norm of W bounds its largest squared column: one product
+        # settles the usual case.
+        frobenius = W.multiply(W).sum() if sparse else np.vdot(W, W)
+        if normal.min() > 1e-12 * self.largest_inverse * frobenius:
             return
+        squares = W.multiply(W) if sparse else W * W
         columns = np.asarray(squares.sum(axis=0)).ravel()
         # Each contact against the inverse masses of the coordinates its normal moves: a light
         # body elsewhere (masses 1e-20 and 1 kg) makes no contact singular.
@@ -390,13 +391,11 @@ def binary_scale(size: float) -> float:
     return math.ldexp(1.0, round(math.log2(size)))
 
 
-def solving_units(
-    M: Any, v: np.ndarray, springs: Iterable[tuple[float, float]]
-) -> tuple[float, float, float]:
+def solving_units(M: Any, v: np.ndarray, contacts: Iterable[Any]) -> tuple[float, float, float]:
     """The units of mass, velocity and time a scale-free law solves an impact in.
 
-    ``M`` and ``v`` are the impact's mass matrix and velocity, ``springs`` the stiffness and
-    exponent of its contacts.
+    ``M`` and ``v`` are the impact's mass matrix and velocity, ``contacts`` its contacts (their
+    stiffness and exponent are read only where the time unit is not 1).
 
     Powers of two (`binary_scale`) near the heaviest diagonal entry of M and the fastest
     component of v, or 1 for a scale within `UNIT_BAND` of 1; when one of them is not 1, the
@@ -428,6 +427,7 @@ def solving_units(
     # Compression time of a spring K d^p loaded by the unit mass at the unit speed:
     # (m / (K v^(p - 1)))^(1 / (p + 1)), in base-2 logarithms to stay clear of overflow.
     mass_log, velocity_log = math.log2(mass_unit), math.log2(velocity_unit)
+    springs = {(contact.stiffness, contact.exponent) for contact in contacts}
     time_log = min(
         (mass_log - math.log2(stiffness) - (exponent - 1.0) * velocity_log) / (exponent + 1.0)
         for stiffness, exponent in springs

@@ -249,6 +249,8 @@ class ImpactProblem:
         Whether M, Wn and Wt are scipy.sparse CSC arrays (a large problem given sparse). Then
         `delassus`, `W` and `contact_delassus` are sparse too; `dense` gives the problem with
         arrays.
+    momentum : array (n,)
+        Generalized momentum before the impact, ``M @ v``.
     T_minus : float
         Kinetic energy before the impact, ``v @ M @ v / 2`` (finite: checked).
     metric : KineticMetric
@@ -274,6 +276,7 @@ class ImpactProblem:
     m: int = field(init=False, repr=False)
     d: int = field(init=False, repr=False)
     sparse: bool = field(init=False, repr=False)
+    momentum: np.ndarray = field(init=False, repr=False)
     T_minus: float = field(init=False, repr=False)
     metric: KineticMetric = field(init=False, repr=False)
 
@@ -330,11 +333,16 @@ class ImpactProblem:
             state["gaps"] = _gaps(gaps, m)
         state["bodies"] = _bodies(bodies, n)
         state["metric"] = KineticMetric(self.M)
-        self._check_normals()
-        T_minus = kinetic_energy(self.M, self.v)
+        # Where M^-1 or v is extreme, the Delassus matrix and the energy overflow: both are
+        # refused below by name, not with a warning.
+        with np.errstate(over="ignore", invalid="ignore"):
+            self._check_normals()
+            momentum = self.M.dot(self.v)
+            T_minus = float(self.v.dot(momentum)) / 2.0
         if not math.isfinite(T_minus):
             raise InvalidProblem(f"v and M give a kinetic energy that overflows ({T_minus})")
-        state["T_minus"] = T_minus
+        momentum.setflags(write=False)
+        state.update(momentum=momentum, T_minus=T_minus)
 
     @classmethod
     def from_arrays(
@@ -399,13 +407,15 @@ class ImpactProblem:
         return cls(M, Wn, v, contacts, Wt, bodies, gaps)
 
     def _check_normals(self) -> None:
-        """Refuse a contact that no motion can push along its normal (`KineticMetric`)."""
+        """Refuse a contact that no motion can push along its normal (`KineticMetric`).
+
+        Called where overflow is silenced: an overflowing compliance is refused by name.
+        """
         if self.n <= SMALL or self.sparse:
             # The Delassus matrix costs little more than its diagonal here (a small or a sparse
             # one), and every rigid law needs it: its diagonal serves (where M^-1 overflows,
             # infinite entries, refused there).
-            with np.errstate(over="ignore"):
-                normal = self.delassus.diagonal()
+            normal = self.delassus.diagonal()
         else:
             normal = self.metric.compliances(self.Wn)
         self.metric.refuse_singular_normals(self.Wn, self.W, normal)
@@ -536,7 +546,7 @@ class ImpactProblem:
             When the impulse or energy unit these give, ``mass velocity`` or
             ``mass velocity^2``, is not a positive double: an answer could not be scaled back.
         """
-        return solving_units(self.M, self.v, {(c.stiffness, c.exponent) for c in self.contacts})
+        return solving_units(self.M, self.v, self.contacts)
 
     def in_units(self, mass: float, velocity: float, time: float) -> ImpactProblem:
         """The problem with masses, velocities and times in units ``mass``, ``velocity``, ``time``.
@@ -572,12 +582,14 @@ def _gaps(gaps: Any, m: int) -> np.ndarray:
 
 def _bodies(bodies: Mapping[str, Sequence[int]] | None, n: int) -> dict[str, tuple[int, ...]]:
     """Body names and the indices of their coordinates, checked to lie in [0, n)."""
-    if bodies is not None and not isinstance(bodies, Mapping):
+    if bodies is None:
+        return {}
+    if not isinstance(bodies, Mapping):
         raise TypeError(
             f"bodies must be a mapping of names to indices, not {type(bodies).__name__}"
         )
     checked: dict[str, tuple[int, ...]] = {}
-    for name, indices in (bodies or {}).items():
+    for name, indices in bodies.items():
         try:
             checked[str(name)] = tuple(map(int, indices))
         except (TypeError, ValueError):
