@@ -16,6 +16,8 @@ law (`lawbench.core.law.Law.scale_free`) solves a problem in units where its hea
 fastest speed are near 1, so that masses of 1e-308 kg or speeds of 1e-300 m/s
 neither under- nor overflow in its linear algebra and integrators. The units are powers of two:
 rescaling by them rounds nothing. `in_units` rescales a problem.
+
+What a problem derives from these on first read it keeps with `cached`.
 """
 
 from __future__ import annotations
@@ -23,8 +25,8 @@ from __future__ import annotations
 import dataclasses
 import math
 import sys
-from collections.abc import Iterable
-from typing import Any, NoReturn
+from collections.abc import Callable, Iterable
+from typing import Any, Generic, NoReturn, TypeVar, overload
 
 import numpy as np
 
@@ -36,6 +38,37 @@ SMALL = 64
 SPARSE_SHARE = 0.05
 # Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
 SOLVE_BLOCK = 256
+
+_T = TypeVar("_T")
+
+
+class cached(Generic[_T]):  # noqa: N801 - read like the decorator it replaces
+    """A property computed on first read and kept in the instance's ``__dict__``.
+
+    As `functools.cached_property`, without the lock it takes on every first read up to Python
+    3.11, which costs as much as the small values a problem keeps (a gap rate, a unit): an
+    immutable object's value is the same whichever thread computes it first.
+    """
+
+    def __init__(self, function: Callable[[Any], _T]) -> None:
+        self.function = function
+        self.name = function.__name__
+        self.__doc__ = function.__doc__
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, instance: None, owner: type | None = None) -> cached[_T]: ...
+
+    @overload
+    def __get__(self, instance: object, owner: type | None = None) -> _T: ...
+
+    def __get__(self, instance: object | None, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        value = instance.__dict__[self.name] = self.function(instance)
+        return value
 
 
 def all_finite(array: np.ndarray) -> bool:

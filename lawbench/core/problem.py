@@ -16,7 +16,6 @@ import math
 import operator
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -25,6 +24,7 @@ from lawbench.core.errors import InvalidProblem
 from lawbench.core.metric import (
     SMALL,
     KineticMetric,
+    cached,
     checked_matrix,
     checked_sparse_matrix,
     in_units,
@@ -407,10 +407,7 @@ class ImpactProblem:
         return cls(M, Wn, v, contacts, Wt, bodies, gaps)
 
     def _check_normals(self) -> None:
-        """Refuse a contact that no motion can push along its normal (`KineticMetric`).
-
-        Called where overflow is silenced: an overflowing compliance is refused by name.
-        """
+        """Refuse a contact that no motion can push along its normal (`KineticMetric`)."""
         if self.n <= SMALL or self.sparse:
             # The Delassus matrix costs little more than its diagonal here (a small or a sparse
             # one), and every rigid law needs it: its diagonal serves (where M^-1 overflows,
@@ -420,24 +417,24 @@ class ImpactProblem:
             normal = self.metric.compliances(self.Wn)
         self.metric.refuse_singular_normals(self.Wn, self.W, normal)
 
-    @cached_property
+    @cached
     def frictional(self) -> bool:
         """Whether some contact has a tangential Jacobian and a positive mu."""
         return self.Wt is not None and bool((self.mu > 0).any())
 
-    @cached_property
+    @cached
     def closed(self) -> np.ndarray:
         """Boolean mask of the contacts with zero gap, the ones an impact involves."""
         closed = self.gaps <= 0.0
         closed.setflags(write=False)
         return closed
 
-    @cached_property
+    @cached
     def closed_count(self) -> int:
         """Number of closed contacts."""
         return self.m - int(np.count_nonzero(self.gaps))
 
-    @cached_property
+    @cached
     def separating(self) -> tuple[int, ...]:
         """Closed contacts whose gap rate is positive before the impact (they separate)."""
         if not self.un.max() > 0.0:
@@ -465,7 +462,7 @@ class ImpactProblem:
         """
         return self.metric.solve(rhs)
 
-    @cached_property
+    @cached
     def delassus(self) -> Any:
         """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse.
 
@@ -473,14 +470,14 @@ class ImpactProblem:
         """
         return self.metric.delassus(self.Wn)
 
-    @cached_property
+    @cached
     def un(self) -> np.ndarray:
         """Pre-impact normal gap rates ``Wn.T @ v``."""
         un = self.Wn.T.dot(self.v)
         un.setflags(write=False)
         return un
 
-    @cached_property
+    @cached
     def W(self) -> Any:
         """Contact Jacobian ``[Wn, Wt]`` (n, m + m*d): normal columns, then tangential."""
         if self.Wt is None:
@@ -491,7 +488,7 @@ class ImpactProblem:
             return scipy.sparse.hstack([self.Wn, self.Wt], format="csc")
         return np.hstack([self.Wn, self.Wt])
 
-    @cached_property
+    @cached
     def contact_delassus(self) -> Any:
         """Delassus matrix of normal and tangential directions ``W.T M^-1 W``.
 
@@ -503,12 +500,12 @@ class ImpactProblem:
             return self.metric.sparse_delassus(self.W)
         return self.metric.symmetric_product(self.W)
 
-    @cached_property
+    @cached
     def ut(self) -> np.ndarray:
         """Pre-impact tangential slip velocities ``Wt.T @ v`` (m*d,); empty without Wt."""
         return np.zeros(0) if self.Wt is None else self.Wt.T @ self.v
 
-    @cached_property
+    @cached
     def mu(self) -> np.ndarray:
         """Friction coefficients, one per contact."""
         return self._per_contact(operator.attrgetter("mu"))
@@ -531,7 +528,7 @@ class ImpactProblem:
         values.setflags(write=False)
         return values
 
-    @cached_property
+    @cached
     def units(self) -> tuple[float, float, float]:
         """The units of mass, velocity and time a scale-free law solves this problem in.
 
