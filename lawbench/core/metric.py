@@ -23,6 +23,7 @@ What a problem derives from these on first read it keeps with `cached`.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import sys
 from collections.abc import Callable, Iterable
@@ -107,6 +108,23 @@ def checked_matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarr
     if array.shape != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
     return read_only_finite(name, array)
+
+
+def checked_gaps(gaps: Any, m: int) -> np.ndarray:
+    """The m initial gaps of a problem, checked finite and non-negative."""
+    gaps = checked_matrix("gaps", gaps, (m,))
+    if (gaps < 0).any():
+        j = int(np.argmax(gaps < 0))
+        raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
+    return gaps
+
+
+@functools.lru_cache(maxsize=64)
+def closed_gaps(m: int) -> np.ndarray:
+    """The gaps of m closed contacts: zeros, read-only, one array shared by every such problem."""
+    gaps = np.zeros(m)
+    gaps.setflags(write=False)
+    return gaps
 
 
 def _non_finite(value: float) -> str:

@@ -25,9 +25,12 @@ from lawbench.core.metric import (
     SMALL,
     KineticMetric,
     cached,
+    checked_gaps,
     checked_matrix,
     checked_sparse_matrix,
+    closed_gaps,
     in_units,
+    is_diagonal,
     is_sparse,
     kinetic_energy,
     read_only_finite,
@@ -205,14 +208,6 @@ def _shared_contact(**coefficients: Any) -> Contact:
     return Contact(**coefficients)
 
 
-@functools.lru_cache(maxsize=64)
-def _no_gaps(m: int) -> np.ndarray:
-    """The gaps of m closed contacts: zeros, read-only, one array shared by every such problem."""
-    gaps = np.zeros(m)
-    gaps.setflags(write=False)
-    return gaps
-
-
 @dataclass(frozen=True, eq=False, init=False)
 class ImpactProblem:
     """An impact at a frozen configuration, validated when built.
@@ -328,9 +323,9 @@ class ImpactProblem:
                 raise InvalidProblem(f"Wt has shape {np.shape(Wt)}, expected ({n}, {m}*d)")
             state.update(Wt=matrix("Wt", Wt, (n, m * d)), d=d)
         if gaps is None:
-            state.update(gaps=_no_gaps(m), closed_count=m)
+            state.update(gaps=closed_gaps(m), closed_count=m)
         else:
-            state["gaps"] = _gaps(gaps, m)
+            state["gaps"] = checked_gaps(gaps, m)
         state["bodies"] = _bodies(bodies, n)
         state["metric"] = KineticMetric(self.M)
         # Where M^-1 or v is extreme, the Delassus matrix and the energy overflow: both are
@@ -471,6 +466,11 @@ class ImpactProblem:
         return self.metric.delassus(self.Wn)
 
     @cached
+    def decoupled(self) -> bool:
+        """Whether the Delassus matrix is diagonal: no contact's impulse moves another's gap."""
+        return is_diagonal(self.delassus)
+
+    @cached
     def un(self) -> np.ndarray:
         """Pre-impact normal gap rates ``Wn.T @ v``."""
         un = self.Wn.T.dot(self.v)
@@ -566,15 +566,6 @@ class ImpactProblem:
             contacts=[c for c, keep in zip(self.contacts, mask, strict=True) if keep],
             gaps=self.gaps[mask],
         )
-
-
-def _gaps(gaps: Any, m: int) -> np.ndarray:
-    """The m initial gaps, checked finite and non-negative."""
-    gaps = checked_matrix("gaps", gaps, (m,))
-    if (gaps < 0).any():
-        j = int(np.argmax(gaps < 0))
-        raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
-    return gaps
 
 
 def _bodies(bodies: Mapping[str, Sequence[int]] | None, n: int) -> dict[str, tuple[int, ...]]:
