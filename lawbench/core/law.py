@@ -374,11 +374,10 @@ class Law(ABC):
             raise SolverFailure(f"{self.name}: the law called sys.exit({exc.code!r})") from None
         except MemoryError:
             raise SolverFailure(f"{self.name}: out of memory (MemoryError)") from None
-        for what, now, then in zip(
-            ("problem", "options"), inputs(problem, options), given, strict=True
-        ):
-            if now != then:
-                raise SolverFailure(f"{self.name}: the law wrote into the {what} it was given")
+        now = inputs(problem, options)
+        if now != given:
+            what = "problem" if now[0] != given[0] else "options"
+            raise SolverFailure(f"{self.name}: the law wrote into the {what} it was given")
         verify_answer(self.name, problem, outcome)
         return outcome
 

@@ -16,15 +16,18 @@ law (`lawbench.core.law.Law.scale_free`) solves a problem in units where its hea
 fastest speed are near 1, so that masses of 1e-308 kg or speeds of 1e-300 m/s
 neither under- nor overflow in its linear algebra and integrators. The units are powers of two:
 rescaling by them rounds nothing. `in_units` rescales a problem.
+
+What a problem derives from these on first read it keeps with `cached`.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import sys
-from collections.abc import Iterable
-from typing import Any, NoReturn
+from collections.abc import Callable, Iterable
+from typing import Any, Generic, NoReturn, TypeVar, overload
 
 import numpy as np
 
@@ -36,6 +39,37 @@ SMALL = 64
 SPARSE_SHARE = 0.05
 # Columns of M^-1 W solved at once through a sparse factor of M: bounds the dense block.
 SOLVE_BLOCK = 256
+
+_T = TypeVar("_T")
+
+
+class cached(Generic[_T]):  # noqa: N801 - read like the decorator it replaces
+    """A property computed on first read and kept in the instance's ``__dict__``.
+
+    As `functools.cached_property`, without the lock it takes on every first read up to Python
+    3.11, which costs as much as the small values a problem keeps (a gap rate, a unit): an
+    immutable object's value is the same whichever thread computes it first.
+    """
+
+    def __init__(self, function: Callable[[Any], _T]) -> None:
+        self.function = function
+        self.name = function.__name__
+        self.__doc__ = function.__doc__
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, instance: None, owner: type | None = None) -> cached[_T]: ...
+
+    @overload
+    def __get__(self, instance: object, owner: type | None = None) -> _T: ...
+
+    def __get__(self, instance: object | None, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        value = instance.__dict__[self.name] = self.function(instance)
+        return value
 
 
 def all_finite(array: np.ndarray) -> bool:
@@ -79,6 +113,23 @@ def checked_matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarr
     if array.shape != shape:
         raise InvalidProblem(f"{name} has shape {array.shape}, expected {shape}")
     return read_only_finite(name, array)
+
+
+def checked_gaps(gaps: Any, m: int) -> np.ndarray:
+    """The m initial gaps of a problem, checked finite and non-negative."""
+    gaps = checked_matrix("gaps", gaps, (m,))
+    if (gaps < 0).any():
+        j = int(np.argmax(gaps < 0))
+        raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
+    return gaps
+
+
+@functools.lru_cache(maxsize=64)
+def closed_gaps(m: int) -> np.ndarray:
+    """The gaps of m closed contacts: zeros, read-only, one array shared by every such problem."""
+    gaps = np.zeros(m)
+    gaps.setflags(write=False)
+    return gaps
 
 
 def _non_finite(value: float) -> str:
@@ -365,11 +416,12 @@ class KineticMetric:
             Naming the first such contact.
         """
         sparse = is_sparse(W)
-        squares = W.multiply(W) if sparse else W * W
-        # The squared Frobenius norm of W bounds its largest squared column: one sum settles
-        # the usual case.
-        if normal.min() > 1e-12 * self.largest_inverse * squares.sum():
+        # The squared Frobenius norm of W bounds its largest squared column: one product
+        # settles the usual case.
+        frobenius = W.multiply(W).sum() if sparse else np.vdot(W, W)
+        if normal.min() > 1e-12 * self.largest_inverse * frobenius:
             return
+        squares = W.multiply(W) if sparse else W * W
         columns = np.asarray(squares.sum(axis=0)).ravel()
         # Each contact against the inverse masses of the coordinates its normal moves: a light
         # body elsewhere (masses 1e-20 and 1 kg) makes no contact singular.
@@ -398,13 +450,11 @@ def binary_scale(size: float) -> float:
     return math.ldexp(1.0, round(math.log2(size)))
 
 
-def solving_units(
-    M: Any, v: np.ndarray, springs: Iterable[tuple[float, float]]
-) -> tuple[float, float, float]:
+def solving_units(M: Any, v: np.ndarray, contacts: Iterable[Any]) -> tuple[float, float, float]:
     """The units of mass, velocity and time a scale-free law solves an impact in.
 
-    ``M`` and ``v`` are the impact's mass matrix and velocity, ``springs`` the stiffness and
-    exponent of its contacts.
+    ``M`` and ``v`` are the impact's mass matrix and velocity, ``contacts`` its contacts (their
+    stiffness and exponent are read only where the time unit is not 1).
 
     Powers of two (`binary_scale`) near the heaviest diagonal entry of M and the fastest
     component of v, or 1 for a scale within `UNIT_BAND` of 1; when one of them is not 1, the
@@ -436,6 +486,7 @@ def solving_units(
     # Compression time of a spring K d^p loaded by the unit mass at the unit speed:
     # (m / (K v^(p - 1)))^(1 / (p + 1)), in base-2 logarithms to stay clear of overflow.
     mass_log, velocity_log = math.log2(mass_unit), math.log2(velocity_unit)
+    springs = {(contact.stiffness, contact.exponent) for contact in contacts}
     time_log = min(
         (mass_log - math.log2(stiffness) - (exponent - 1.0) * velocity_log) / (exponent + 1.0)
         for stiffness, exponent in springs

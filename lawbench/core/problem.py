@@ -16,7 +16,6 @@ import math
 import operator
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -26,9 +25,13 @@ from lawbench.core.geometry import Geometry
 from lawbench.core.metric import (
     SMALL,
     KineticMetric,
+    cached,
+    checked_gaps,
     checked_matrix,
     checked_sparse_matrix,
+    closed_gaps,
     in_units,
+    is_diagonal,
     is_sparse,
     kinetic_energy,
     read_only_finite,
@@ -217,14 +220,6 @@ def _shared_contact(**coefficients: Any) -> Contact:
     return Contact(**coefficients)
 
 
-@functools.lru_cache(maxsize=64)
-def _no_gaps(m: int) -> np.ndarray:
-    """The gaps of m closed contacts: zeros, read-only, one array shared by every such problem."""
-    gaps = np.zeros(m)
-    gaps.setflags(write=False)
-    return gaps
-
-
 @dataclass(frozen=True, eq=False, init=False)
 class ImpactProblem:
     """An impact at a frozen configuration, validated when built.
@@ -264,6 +259,8 @@ class ImpactProblem:
         Whether M, Wn and Wt are scipy.sparse CSC arrays (a large problem given sparse). Then
         `delassus`, `W` and `contact_delassus` are sparse too; `dense` gives the problem with
         arrays.
+    momentum : array (n,)
+        Generalized momentum before the impact, ``M @ v``.
     T_minus : float
         Kinetic energy before the impact, ``v @ M @ v / 2`` (finite: checked).
     metric : KineticMetric
@@ -290,6 +287,7 @@ class ImpactProblem:
     m: int = field(init=False, repr=False)
     d: int = field(init=False, repr=False)
     sparse: bool = field(init=False, repr=False)
+    momentum: np.ndarray = field(init=False, repr=False)
     T_minus: float = field(init=False, repr=False)
     metric: KineticMetric = field(init=False, repr=False)
 
@@ -342,19 +340,24 @@ class ImpactProblem:
                 raise InvalidProblem(f"Wt has shape {np.shape(Wt)}, expected ({n}, {m}*d)")
             state.update(Wt=matrix("Wt", Wt, (n, m * d)), d=d)
         if gaps is None:
-            state.update(gaps=_no_gaps(m), closed_count=m)
+            state.update(gaps=closed_gaps(m), closed_count=m)
         else:
-            state["gaps"] = _gaps(gaps, m)
+            state["gaps"] = checked_gaps(gaps, m)
         state["bodies"] = _bodies(bodies, n)
         if geometry is not None and not isinstance(geometry, Geometry):
             raise InvalidProblem(f"geometry is {type(geometry).__name__}, not Geometry")
         state["geometry"] = geometry
         state["metric"] = KineticMetric(self.M)
-        self._check_normals()
-        T_minus = kinetic_energy(self.M, self.v)
+        # Where M^-1 or v is extreme, the Delassus matrix and the energy overflow: both are
+        # refused below by name, not with a warning.
+        with np.errstate(over="ignore", invalid="ignore"):
+            self._check_normals()
+            momentum = self.M.dot(self.v)
+            T_minus = float(self.v.dot(momentum)) / 2.0
         if not math.isfinite(T_minus):
             raise InvalidProblem(f"v and M give a kinetic energy that overflows ({T_minus})")
-        state["T_minus"] = T_minus
+        momentum.setflags(write=False)
+        state.update(momentum=momentum, T_minus=T_minus)
 
     @classmethod
     def from_arrays(
@@ -424,30 +427,29 @@ class ImpactProblem:
             # The Delassus matrix costs little more than its diagonal here (a small or a sparse
             # one), and every rigid law needs it: its diagonal serves (where M^-1 overflows,
             # infinite entries, refused there).
-            with np.errstate(over="ignore"):
-                normal = self.delassus.diagonal()
+            normal = self.delassus.diagonal()
         else:
             normal = self.metric.compliances(self.Wn)
         self.metric.refuse_singular_normals(self.Wn, self.W, normal)
 
-    @cached_property
+    @cached
     def frictional(self) -> bool:
         """Whether some contact has a tangential Jacobian and a positive mu."""
         return self.Wt is not None and bool((self.mu > 0).any())
 
-    @cached_property
+    @cached
     def closed(self) -> np.ndarray:
         """Boolean mask of the contacts with zero gap, the ones an impact involves."""
         closed = self.gaps <= 0.0
         closed.setflags(write=False)
         return closed
 
-    @cached_property
+    @cached
     def closed_count(self) -> int:
         """Number of closed contacts."""
         return self.m - int(np.count_nonzero(self.gaps))
 
-    @cached_property
+    @cached
     def separating(self) -> tuple[int, ...]:
         """Closed contacts whose gap rate is positive before the impact (they separate)."""
         if not self.un.max() > 0.0:
@@ -475,7 +477,7 @@ class ImpactProblem:
         """
         return self.metric.solve(rhs)
 
-    @cached_property
+    @cached
     def delassus(self) -> Any:
         """Normal Delassus matrix ``G = Wn.T M^-1 Wn`` (m, m): gap-rate change per impulse.
 
@@ -483,14 +485,19 @@ class ImpactProblem:
         """
         return self.metric.delassus(self.Wn)
 
-    @cached_property
+    @cached
+    def decoupled(self) -> bool:
+        """Whether the Delassus matrix is diagonal: no contact's impulse moves another's gap."""
+        return is_diagonal(self.delassus)
+
+    @cached
     def un(self) -> np.ndarray:
         """Pre-impact normal gap rates ``Wn.T @ v``."""
         un = self.Wn.T.dot(self.v)
         un.setflags(write=False)
         return un
 
-    @cached_property
+    @cached
     def W(self) -> Any:
         """Contact Jacobian ``[Wn, Wt]`` (n, m + m*d): normal columns, then tangential."""
         if self.Wt is None:
@@ -501,7 +508,7 @@ class ImpactProblem:
             return scipy.sparse.hstack([self.Wn, self.Wt], format="csc")
         return np.hstack([self.Wn, self.Wt])
 
-    @cached_property
+    @cached
     def contact_delassus(self) -> Any:
         """Delassus matrix of normal and tangential directions ``W.T M^-1 W``.
 
@@ -513,12 +520,12 @@ class ImpactProblem:
             return self.metric.sparse_delassus(self.W)
         return self.metric.symmetric_product(self.W)
 
-    @cached_property
+    @cached
     def ut(self) -> np.ndarray:
         """Pre-impact tangential slip velocities ``Wt.T @ v`` (m*d,); empty without Wt."""
         return np.zeros(0) if self.Wt is None else self.Wt.T @ self.v
 
-    @cached_property
+    @cached
     def mu(self) -> np.ndarray:
         """Friction coefficients, one per contact."""
         return self._per_contact(operator.attrgetter("mu"))
@@ -541,7 +548,7 @@ class ImpactProblem:
         values.setflags(write=False)
         return values
 
-    @cached_property
+    @cached
     def units(self) -> tuple[float, float, float]:
         """The units of mass, velocity and time a scale-free law solves this problem in.
 
@@ -556,7 +563,7 @@ class ImpactProblem:
             When the impulse or energy unit these give, ``mass velocity`` or
             ``mass velocity^2``, is not a positive double: an answer could not be scaled back.
         """
-        return solving_units(self.M, self.v, {(c.stiffness, c.exponent) for c in self.contacts})
+        return solving_units(self.M, self.v, self.contacts)
 
     def in_units(self, mass: float, velocity: float, time: float) -> ImpactProblem:
         """The problem with masses, velocities and times in units ``mass``, ``velocity``, ``time``.
@@ -581,23 +588,16 @@ class ImpactProblem:
         )
 
 
-def _gaps(gaps: Any, m: int) -> np.ndarray:
-    """The m initial gaps, checked finite and non-negative."""
-    gaps = checked_matrix("gaps", gaps, (m,))
-    if (gaps < 0).any():
-        j = int(np.argmax(gaps < 0))
-        raise InvalidProblem(f"gaps[{j}] = {gaps[j]:g}: must be >= 0")
-    return gaps
-
-
 def _bodies(bodies: Mapping[str, Sequence[int]] | None, n: int) -> dict[str, tuple[int, ...]]:
     """Body names and the indices of their coordinates, checked to lie in [0, n)."""
-    if bodies is not None and not isinstance(bodies, Mapping):
+    if bodies is None:
+        return {}
+    if not isinstance(bodies, Mapping):
         raise TypeError(
             f"bodies must be a mapping of names to indices, not {type(bodies).__name__}"
         )
     checked: dict[str, tuple[int, ...]] = {}
-    for name, indices in (bodies or {}).items():
+    for name, indices in bodies.items():
         try:
             checked[str(name)] = tuple(map(int, indices))
         except (TypeError, ValueError):

@@ -378,7 +378,12 @@ def _affine(rows: list[list[float]], z: list[float], q: list[float]) -> list[flo
 
 
 def solve_lcp(
-    G: np.ndarray, q: np.ndarray, tol: float = 1e-10, refine: bool = True, method: str = "clarabel"
+    G: np.ndarray,
+    q: np.ndarray,
+    tol: float = 1e-10,
+    refine: bool = True,
+    method: str = "clarabel",
+    decoupled: bool | None = None,
 ) -> LCPResult:
     """Solve ``0 <= G z + q _|_ z >= 0`` for a symmetric positive semidefinite ``G``.
 
@@ -395,8 +400,13 @@ def solve_lcp(
     method : {'clarabel', 'nnls'}
         The solver of coupled problems beyond `ENUMERATION_MAX` contacts (or where the
         enumeration finds no set, a numerically singular problem).
+    decoupled : bool, optional
+        Whether ``G`` is diagonal, where the caller knows it (`ImpactProblem.decoupled`);
+        None tests it here.
     """
-    if is_diagonal(G):
+    if decoupled is None:
+        decoupled = is_diagonal(G)
+    if decoupled:
         diagonal = G.diagonal()
         if (diagonal <= 0).any():
             raise SolverFailure("the LCP matrix has a zero diagonal entry")

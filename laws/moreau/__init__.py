@@ -128,7 +128,7 @@ from lawbench.checks.regions import option, separating_contact
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law, current_budget
-from lawbench.core.metric import as_array, is_diagonal
+from lawbench.core.metric import as_array
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
@@ -283,7 +283,7 @@ class Moreau(Law):
             return _resolve_friction(problem, e * restituted, options)
         large = problem.m > ENUMERATION_MAX
         single_e = large and (e == e[0]).all() and np.array_equal(restituted, un)
-        if single_e and large and not is_diagonal(problem.delassus):
+        if single_e and large and not problem.decoupled:
             plastic = project_on_cone(
                 problem.M,
                 problem.v,
@@ -296,7 +296,11 @@ class Moreau(Law):
             formulation = "cone projection (clarabel)"
         else:
             result = solve_lcp(
-                problem.delassus, un + e * restituted, options["tol"], options["polish"]
+                problem.delassus,
+                un + e * restituted,
+                options["tol"],
+                options["polish"],
+                decoupled=problem.decoupled,
             )
             Pn, formulation = result.z, result.method
         diagnostics = {
