@@ -93,6 +93,21 @@ def as_array(value: Any) -> np.ndarray:
     return value.toarray() if is_sparse(value) else value
 
 
+def checked_range(label: str, value: float, low: float, high: float | None = None) -> None:
+    """Raise `InvalidProblem` unless ``low <= value <= high`` (``high`` None: unbounded)."""
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:  # an integer beyond the largest double (10**400)
+        raise InvalidProblem(
+            f"{label}: an integer of {int(value).bit_length()} bits, beyond double precision"
+        ) from None
+    if not finite:
+        raise InvalidProblem(f"{label} = {value}: must be a finite number")
+    if value < low or (high is not None and value > high):
+        bounds = f"in [{low:g}, {high:g}]" if high is not None else f">= {low:g}"
+        raise InvalidProblem(f"{label} = {value:g}: must be {bounds}")
+
+
 def checked_matrix(name: str, value: object, shape: tuple[int, ...]) -> np.ndarray:
     """Return ``value`` as a read-only float array of ``shape``, or raise `InvalidProblem`.
 

@@ -28,6 +28,7 @@ from lawbench.core.metric import (
     cached,
     checked_gaps,
     checked_matrix,
+    checked_range,
     checked_sparse_matrix,
     closed_gaps,
     in_units,
@@ -63,21 +64,6 @@ CONTACT_RANGES = (
 )
 # Up to this many distinct contacts are checked one by one; more, as one table of numbers.
 CHECKED_ONE_BY_ONE = 8
-
-
-def _check_range(label: str, value: float, low: float, high: float | None = None) -> None:
-    """Raise `InvalidProblem` unless ``low <= value <= high`` (``high`` None: unbounded)."""
-    try:
-        finite = math.isfinite(value)
-    except OverflowError:  # an integer beyond the largest double (10**400)
-        raise InvalidProblem(
-            f"{label}: an integer of {int(value).bit_length()} bits, beyond double precision"
-        ) from None
-    if not finite:
-        raise InvalidProblem(f"{label} = {value}: must be a finite number")
-    if value < low or (high is not None and value > high):
-        bounds = f"in [{low:g}, {high:g}]" if high is not None else f">= {low:g}"
-        raise InvalidProblem(f"{label} = {value:g}: must be {bounds}")
 
 
 @dataclass(frozen=True)
@@ -132,7 +118,7 @@ class Contact:
                 if name in _UNSET_ALLOWED:
                     continue
                 raise InvalidProblem(f"{label}.{name} = None: must be a number")
-            _check_range(f"{label}.{name}", value, low, high)
+            checked_range(f"{label}.{name}", value, low, high)
             if positive and value == 0.0:
                 raise InvalidProblem(f"{label}.{name} = 0: must be > 0")
 
