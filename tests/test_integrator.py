@@ -139,6 +139,7 @@ STEPPING = {
     "darboux_keller": None,
     "moreau": ("lamina", {}, {"friction": "coulomb", "method": "fixed_point"}),
     "sequential": ("two_balls_wall", {"e": 0.0}, {}),
+    "drake": ("three_ball_chain", {}, {}),
     "mujoco": ("three_ball_chain", {}, {}),
     "pybullet": ("three_ball_chain", {}, {}),
 }

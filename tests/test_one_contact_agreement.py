@@ -26,6 +26,8 @@ def test_every_law_agrees_on_one_frictionless_contact(law, e):
         v=[1.0, -0.5],
         contacts=[Contact(e=e, stiffness=1e6, exponent=1.0)],
     )
+    if reason := lawbench.LAWS.get(law).refusal(problem):
+        pytest.skip(f"refused: {reason}")  # an engine builds only a scene with its geometry
     options = {"model": "kelvin_voigt", "termination": "gap"} if law == "compliant" else {}
     outcome = lawbench.LAWS.get(law).resolve(problem, **options)
     newton = lawbench.LAWS.get("newton").resolve(problem)

@@ -159,7 +159,9 @@ import dataclasses, pathlib, sys
 from lawbench.views.report import write_report
 from lawbench.views.report.config import QUICK
 
-config = dataclasses.replace(QUICK, laws=("mirror", "newton"), cases=("ball_on_wall",), workers=1)
+config = dataclasses.replace(
+    QUICK, laws=("mirror", "newton"), cases=("ball_on_wall",), measurements=(), workers=1
+)
 write_report(pathlib.Path(sys.argv[1]), config=config)
 """
 

@@ -11,7 +11,9 @@ import lawbench
 from lawbench.files.problem_files import load_problem, save_problem
 
 ENCODINGS = (".json", ".npz", ".h5")
-# The integrating laws cost seconds a solve: their round trip is checked on the defaults.
+# The integrating laws cost seconds a solve and read the same arrays, which `same_problem`
+# compares bit for bit: the closed-form laws' outcomes check what the arrays do not show (their
+# types and layout).
 SLOW = {"compliant", "lzb", "jia", "darboux_keller"}
 
 
@@ -49,7 +51,7 @@ def test_every_scene_round_trips_to_an_identical_problem_and_outcomes(case, exam
     for copy in loaded.values():
         same_problem(problem, copy)
     for law in lawbench.LAWS.values():
-        if law.name in SLOW and example != next(iter(scene.examples)):
+        if law.name in SLOW:
             continue
         if law.refusal(loaded[ENCODINGS[0]]) == "the scene declares no geometry":
             continue  # a file does not carry the geometry an engine builds
