@@ -32,6 +32,7 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.laws._claims import RIGID_DISPERSION, keeps_energy, never_creates_energy
+from lawbench.laws._options import bound, path_option
 
 APPROACH_TOLERANCE = 1e-12
 RECORDED = 10_000
@@ -68,8 +69,8 @@ class Sequential(Law):
             kind="str",
             choices=ORDERS,
         ),
-        Spec("max_steps", 1_000_000, "bound on the number of binary impacts", kind="int", low=1),
-        Spec("path", False, "return the velocities after each binary impact", kind="bool"),
+        bound("max_steps", 1_000_000, "bound on the number of binary impacts"),
+        path_option("the velocities after each binary impact"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -76,6 +76,7 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.laws._claims import keeps_energy, never_creates_energy
+from lawbench.laws._options import bound, path_option
 from lawbench.laws.compliant.friction import FrictionalIntegration
 from lawbench.laws.compliant.normal import (
     DAMPING_RULES,
@@ -144,9 +145,9 @@ class Compliant(Law):
             kind="str",
             choices=("auto", "DOP853", "RK45", "Radau", "LSODA"),
         ),
-        Spec("max_steps", 200_000, "budget of integrator steps", kind="int", low=1),
-        Spec("max_events", 100_000, "budget of restarts at contact events", kind="int", low=1),
-        Spec("path", False, "return time histories of forces and stored energies", kind="bool"),
+        bound("max_steps", 200_000, "budget of integrator steps"),
+        bound("max_events", 100_000, "budget of restarts at contact events"),
+        path_option("time histories of forces and stored energies"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -67,6 +67,7 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.laws._claims import keeps_energy, never_creates_energy
+from lawbench.laws._options import bound, path_option
 from lawbench.laws.darboux_keller import batch as batch_phases
 from lawbench.laws.darboux_keller.dynamics import (
     ImpactRecord,
@@ -123,13 +124,8 @@ class DarbouxKeller(Law):
             low=1e-13,
             high=1e-2,
         ),
-        Spec(
-            "path",
-            False,
-            "return impulses, contact velocities and work along the impact",
-            kind="bool",
-        ),
-        Spec("max_steps", 100_000, "budget of integrator steps of turning slip", kind="int", low=1),
+        path_option("impulses, contact velocities and work along the impact"),
+        bound("max_steps", 100_000, "budget of integrator steps of turning slip"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -44,6 +44,7 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 from lawbench.core.verdicts import Region
+from lawbench.laws._options import bound
 
 # Steps in a row without contact force that end an impact (with no contact approaching).
 QUIET_STEPS = 5
@@ -213,7 +214,7 @@ def engine_options(steps: dict[str, float], default: str, tuned: str) -> tuple[S
             low=0.0,
             high=0.01,
         ),
-        Spec("max_steps", 100_000, "bound on the engine's steps", kind="int", low=1),
+        bound("max_steps", 100_000, "bound on the engine's steps"),
     )
 
 

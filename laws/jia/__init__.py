@@ -81,6 +81,7 @@ from lawbench.laws._claims import (
     keeps_energy,
     never_creates_energy,
 )
+from lawbench.laws._options import bound, path_option
 from lawbench.laws.jia.dynamics import SpringImpact, Springs
 from lawbench.numerics.solvers import solve_lcp
 
@@ -144,14 +145,9 @@ class Jia(Law):
             high=1e-2,
             low_open=True,
         ),
-        Spec(
-            "path",
-            False,
-            "return the impulse curve (impulses, spring energies, contact velocities)",
-            kind="bool",
-        ),
-        Spec("max_steps", 1_000_000, "budget of integrator steps", kind="int", low=1),
-        Spec("max_events", 10_000, "budget of contact state transitions", kind="int", low=1),
+        path_option("the impulse curve (impulses, spring energies, contact velocities)"),
+        bound("max_steps", 1_000_000, "budget of integrator steps"),
+        bound("max_events", 10_000, "budget of contact state transitions"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:

@@ -125,6 +125,7 @@ from lawbench.laws._claims import (
     keeps_energy,
     never_creates_energy,
 )
+from lawbench.laws._options import bound, path_option
 from lawbench.laws.lzb.dynamics import RECORDED, REST_FACTOR, EnergeticImpact
 
 
@@ -170,14 +171,9 @@ class LiuZhaoBrogliato(Law):
         Spec(
             "method", "DOP853", "solve_ivp method", kind="str", choices=("DOP853", "RK45", "Radau")
         ),
-        Spec("max_steps", 200_000, "budget of integrator steps", kind="int", low=1),
-        Spec("max_events", 20_000, "budget of restarts at events", kind="int", low=1),
-        Spec(
-            "path",
-            False,
-            "return impulses, velocities and stored energies along the impact",
-            kind="bool",
-        ),
+        bound("max_steps", 200_000, "budget of integrator steps"),
+        bound("max_events", 20_000, "budget of restarts at events"),
+        path_option("impulses, velocities and stored energies along the impact"),
     )
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
