@@ -26,7 +26,8 @@ MAX_MODULES = 16
 
 def _importing(frame: FrameType | None) -> bool:
     while frame is not None:
-        if frame.f_code.co_name == "<module>" and frame.f_globals.get("__name__") != "__main__":
+        module = frame.f_globals.get("__name__", "")
+        if frame.f_code.co_name == "<module>" and module.startswith("lawbench"):
             return True
         frame = frame.f_back
     return False
