@@ -4,7 +4,6 @@ Most tests read one small report (the closed-form and single-contact laws on a f
 written once into a temporary folder; the slow tests run the true quick mode end to end.
 """
 
-import dataclasses
 import re
 import subprocess
 import sys
@@ -14,12 +13,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import CLOSED_FORM, SMALL
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 import lawbench
 from lawbench.core.verdicts import Verdict
 from lawbench.studies.declared import STUDIES
-from lawbench.views.report import QUICK, write_report
+from lawbench.views.report import write_report
 from lawbench.views.report.config import view
 from lawbench.views.report.inside import QUANTITIES
 from lawbench.views.report.marks import Mark
@@ -29,7 +29,6 @@ from lawbench.views.report.plots import figure, log_scale
 from lawbench.views.report.tradeoff import pareto
 
 SECTIONS = ("summary", "outcomes", "tradeoff", "stability", "paradoxes", "dispersion", "inside")
-CLOSED_FORM = ("newton", "poisson", "sequential", "moreau")
 DECADE_STUDIES = (
     "three_ball_chain_stiffness",
     "three_ball_chain_masses",
@@ -39,27 +38,7 @@ DECADE_STUDIES = (
 ROUNDING = 1e-12
 CHROMIUM = Path("/usr/bin/chromium")
 CLASSES = {str(v) for v in Verdict}
-
-# The closed-form laws and two single-contact laws on the scenes every section needs; the section
-# against measurements has its own tests (test_report_measured.py) and draws Kharaz's curves here.
-SMALL = dataclasses.replace(
-    QUICK,
-    measurements=(),
-    laws=(*CLOSED_FORM, "brach", "darboux_keller"),
-    cases=(
-        "three_ball_chain",
-        "two_balls_wall",
-        "ball_chain",
-        "falling_rod",
-        "double_pendulum",
-        "lamina",
-    ),
-)
-
-
-@pytest.fixture(scope="module")
-def report(tmp_path_factory):
-    return write_report(tmp_path_factory.mktemp("report") / "small", config=SMALL)
+SET_ASIDE = ("numerical failure", "budget", "unexplained")
 
 
 @pytest.fixture(scope="module")
@@ -194,7 +173,7 @@ def test_the_page_writes_every_file_escapes_and_keeps_the_rerun_command(tmp_path
 def test_every_section_is_in_both_pages(report):
     page, markdown = (report / "index.html").read_text(), (report / "report.md").read_text()
     for anchor in SECTIONS:
-        assert f'<h2 id="{anchor}">' in page, anchor
+        assert re.search(rf'<h3 id="{anchor}">', page), anchor
         assert f'<a id="{anchor}"></a>' in markdown, anchor
     assert "This section failed" not in page
 
@@ -329,32 +308,11 @@ def test_speed_accuracy_shows_model_and_numerical_error_apart(report):
     assert measured["model_error"].notna().all()
     exact = measured[measured["knob"].isna()]
     assert (exact["numerical_error"] == 0).all()
-    cheapest = pd.read_csv(report / "tradeoff_cheapest.csv").set_index("scene")
-    assert cheapest.loc["three_ball_chain", "ground truth"] == "compliant (tol=1e-10)"
+    answer = pd.read_csv(report / "answer.csv").set_index("scene")
+    truth = answer.loc["[three_ball_chain](#scene-three_ball_chain)", "ground truth"]
+    assert truth == "compliant (tol=1e-10)"
     page = (report / "index.html").read_text()
     assert "model error against the ground truth, compliant (tol=1e-10)" in page
-
-
-def test_on_the_lamina_the_cheapest_law_is_as_close_to_the_ground_truth_as_each_level(report):
-    """Brach's omega+ = 0.5 (Brogliato 2010, eq. 11 on the lamina) is measured against the
-    compliant ground truth's own answer, and the truth's model is never the cheapest law."""
-    case = lawbench.CASES.get("lamina")
-    truth = case.ground_truth
-    omega = lawbench.LAWS.get(truth.law).resolve(case.build(), **truth.options).v_plus[0]
-    points = pd.read_csv(report / "tradeoff_lamina.csv")
-    brach = points[points["law"] == "brach"]
-    assert brach["model_error"].iloc[0] == pytest.approx(abs(0.5 - omega), rel=1e-6)
-    cheapest = pd.read_csv(report / "tradeoff_cheapest.csv").set_index("scene")
-    lamina = cheapest.loc["lamina"]
-    assert lamina["ground truth"] == truth.describe()
-    assert lamina["answer"].endswith(".") and "comes closest" in lamina["answer"]
-    for level in (1e-2, 1e-4, 1e-6):
-        chosen = lamina[f"within {level:g}"]
-        law = chosen.split(" ")[0].rstrip(",")
-        assert law not in ("brach", truth.law)
-        if law != "none":
-            errors = points[points["law"] == law]["model_error"]
-            assert errors.min() <= level, (level, chosen)
 
 
 def test_every_declared_study_is_on_the_page_or_listed_with_why_it_is_not(report):
@@ -422,74 +380,6 @@ def test_reproducers_rerun_their_cell_and_exit_with_the_status_shown(report):
     for command, status, process in processes:
         _, stderr = process.communicate(timeout=300)
         assert process.returncode == status, (command, stderr)
-
-
-@pytest.mark.skipif(
-    not CHROMIUM.exists(), reason="needs /usr/bin/chromium (Debian package chromium)"
-)
-def test_the_page_renders_in_chromium_with_its_legend_figures_and_commands(report, tmp_path):
-    probe = report / "probe.html"
-    script = (
-        "<script>window.addEventListener('load', () => {"
-        "const images = Array.from(document.images);"
-        "const broken = images.filter(i => !i.complete || i.naturalWidth === 0).map(i => i.src);"
-        "const legend = document.querySelector('#summary ~ .legend');"
-        "const marks = legend ? Array.from(legend.querySelectorAll('.mark')) : [];"
-        "const commands = Array.from(document.querySelectorAll('code.reproducer'));"
-        "const strays = commands.filter(c => !c.textContent.startsWith('lawbench '));"
-        "document.body.setAttribute('data-images', images.length);"
-        "document.body.setAttribute('data-broken', broken.join(' '));"
-        "document.body.setAttribute('data-legend', marks.map(m => m.textContent).join('|'));"
-        "document.body.setAttribute('data-colours', "
-        "new Set(marks.map(m => getComputedStyle(m).backgroundColor)).size);"
-        "document.body.setAttribute('data-commands', commands.length);"
-        "document.body.setAttribute('data-strays', strays.map(c => c.textContent).join('|'));"
-        "const page = document.documentElement.clientWidth;"
-        "const wide = Array.from(document.querySelectorAll('table, figure'))"
-        ".filter(e => e.getBoundingClientRect().right > page + 1)"
-        ".map(e => e.id + ':' + Math.round(e.getBoundingClientRect().width));"
-        "document.body.setAttribute('data-width', document.documentElement.scrollWidth);"
-        "document.body.setAttribute('data-wide', wide.join(' '));"
-        "});</script>"
-    )
-    probe.write_text((report / "index.html").read_text().replace("</body>", script + "</body>"))
-    command = [
-        str(CHROMIUM),
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--allow-file-access-from-files",
-        "--virtual-time-budget=20000",
-    ]
-    dom = subprocess.run(
-        [*command, "--window-size=1280,2000", "--dump-dom", probe.as_uri()],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=True,
-    ).stdout
-    images = int(re.search(r'data-images="(\d+)"', dom)[1])
-    assert images == len(figures_of((report / "index.html").read_text())) > 0
-    assert 'data-broken=""' in dom, re.search(r'data-broken="([^"]*)"', dom)[1]
-    for anchor in SECTIONS:
-        assert f'id="{anchor}"' in dom, anchor
-    legend = re.search(r'data-legend="([^"]*)"', dom)[1].split("|")
-    assert [text.rstrip("✓✗!·»?") for text in legend] == [str(v) for v in Verdict]
-    assert re.search(r'data-colours="(\d+)"', dom)[1] == str(len(Verdict))
-    assert int(re.search(r'data-commands="(\d+)"', dom)[1]) > 0
-    assert 'data-strays=""' in dom, re.search(r'data-strays="([^"]*)"', dom)[1]
-    # At 1280 px every table and figure fits the page: nothing to scroll sideways.
-    assert int(re.search(r'data-width="(\d+)"', dom)[1]) <= 1280
-    assert 'data-wide=""' in dom, re.search(r'data-wide="([^"]*)"', dom)[1]
-    shot = tmp_path / "page.png"
-    subprocess.run(
-        [*command, f"--screenshot={shot}", "--window-size=1280,2000", probe.as_uri()],
-        capture_output=True,
-        timeout=120,
-        check=True,
-    )
-    assert shot.stat().st_size > 10_000
-    probe.unlink()
 
 
 # Slow: the true quick mode, every law and scene.

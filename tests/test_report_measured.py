@@ -69,9 +69,9 @@ def test_the_first_screen_links_the_section_and_the_page_shows_it(
     out = build.build(tmp_path / "report", config)
     page = (out / "index.html").read_text()
     top = page.split("<ol>", 1)[0]
-    assert "Closest to measurement" in top and '<a href="#measured">' in top
-    assert "<code>whittaker</code>" in top
-    assert '<h2 id="measured">Against measurements</h2>' in page
+    assert '<table id="answer"' in top and "closest to measurement" in top
+    assert '<a href="#measured">tiny</a>' in top and "<code>whittaker</code>" in top
+    assert '<h3 id="measured">Against measurements</h3>' in page
     assert (out / "measured_tiny.csv").exists()
     assert (out / "measured_tiny_scatter.svg").exists()
     assert "Kharaz" in page  # the curves' absence is said, not hidden

@@ -1,9 +1,12 @@
 """Assemble the report: run every study the sections draw, then build the sections and pages.
 
 The studies run once, together, through one executor (`lawbench.views.report.runs.Context.run`);
-each section is then a view of their tables. The headline counts the *unexplained* cells of every
-table and lists each with the command that reproduces it. A section that fails is kept in the report
-with its error.
+each section is then a view of their tables. The page opens on the answer
+(`lawbench.views.report.answer`): per scene, the law closest to the ground truth and the cheapest
+law at each accuracy level, and per measured set the law closest to measurement. Then each
+scene, the laws, and the health of the run (`lawbench.views.report.layout`): the headline counts
+the *unexplained* cells, numerical failures and budgets of every table and lists each with the
+command that reproduces it. A section that fails is kept in the report with its error.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from lawbench.core.errors import SolverFailure
 from lawbench.core.verdicts import Verdict
 from lawbench.studies.guard import Guard
 from lawbench.views.report import (
+    answer,
     dispersion,
     inside,
     measured,
@@ -37,7 +41,16 @@ from lawbench.views.report import (
     tradeoff,
 )
 from lawbench.views.report.config import Config
-from lawbench.views.report.page import Figure, Section, Table, save_figure, write_page
+from lawbench.views.report.layout import arrange
+from lawbench.views.report.page import (
+    Block,
+    Details,
+    Figure,
+    Section,
+    Table,
+    save_figure,
+    write_page,
+)
 from lawbench.views.report.runs import Context, label
 
 SECTIONS: tuple[ModuleType, ...] = (
@@ -76,10 +89,13 @@ def build(out: Path, config: Config) -> Path:
     ctx.run([view for module in SECTIONS for view in module.VIEWS])
     with Guard(config.workers, DRAWING_S) as drawing:
         drawing.start()  # the drawing workers start up while the sections are built
-        sections = [_section(module, ctx) for module in SECTIONS]
+        topics = {module.ANCHOR: _section(module, ctx) for module in SECTIONS}
+        first = answer_blocks(ctx)
         seconds = time.perf_counter() - start
-        preamble = [measured.first_screen(ctx), *_preamble(ctx, config, seconds), *headline(ctx)]
-        write_page(out, TITLE, preamble, sections, ctx.rerun, _save(drawing))
+        counts, *lists = headline(ctx)
+        health = [counts, *_preamble(ctx, config, seconds), *lists]
+        sections = arrange(topics, [case.name for case in ctx.cases], health)
+        write_page(out, TITLE, [*first, counts], sections, ctx.rerun, _save(drawing))
     return out
 
 
@@ -142,6 +158,7 @@ def headline(ctx: Context) -> list[Any]:
                     "why": _why(row, checks, verdict),
                     "reproducer": row["reproducer"],
                     "exit status": row["exit_status"],
+                    "anchor": answer.cell_anchor(row["reproducer"]),
                 }
             )
     cells = sum(len(t[t["repeat"] == 0]) for _, t in ctx.every_table())
@@ -150,7 +167,8 @@ def headline(ctx: Context) -> list[Any]:
         for verdict, (name, plural, _) in COUNTED.items()
     )
     blocks: list[Any] = [
-        f"Among the {cells} cells of {len(ctx.studies)} studies: {counts}. Each listed cell "
+        f"Health of the run: among the {cells} cells of {len(ctx.studies)} studies, {counts}. "
+        "Each listed cell "
         "comes with a command that reruns it and exits with the status shown (0 answered, "
         "3 refused, 4 budget or solver failure)."
     ]
@@ -158,22 +176,57 @@ def headline(ctx: Context) -> list[Any]:
         if lists[verdict]:
             caption = f"Every cell of the report whose verdict is {verdict} ({meaning})."
             frame = pd.DataFrame(lists[verdict])
-            blocks.append(Table(name, caption, frame, commands=("reproducer",)))
+            table = Table(
+                name, caption, frame, commands=("reproducer",), anchors="anchor", hidden=("anchor",)
+            )
+            blocks.append(table)
     return blocks
 
 
-def _preamble(ctx: Context, config: Config, seconds: float) -> list[str]:
+def _preamble(ctx: Context, config: Config, seconds: float) -> list[Block]:
     left_out = "; ".join(f"`{name}`: {why}" for name, why in ctx.left_out.items())
-    return [
-        f"Mode `{config.mode}`: computed in {seconds:.0f} s (before drawing the figures) "
-        f"with {config.workers} worker processes (executor `{config.executor}`; wall-clock "
-        f"guard {config.budget_s:g} s per cell). Rerun: `{ctx.rerun}`.",
+    listed = [
         f"Laws: {', '.join(f'`{law.name}`' for law in ctx.laws) or 'none'}. "
         f"Scenes: {', '.join(f'`{case.name}`' for case in ctx.cases) or 'none'}. "
         f"Studies: {', '.join(f'`{s.name}`' for s in ctx.studies) or 'none'} "
         "(`lawbench study NAME` runs one).",
+        *([f"Declared studies left out of this page: {left_out}."] if left_out else []),
+    ]
+    return [
+        f"Mode `{config.mode}`: computed in {seconds:.0f} s (before drawing the figures) "
+        f"with {config.workers} worker processes (executor `{config.executor}`; wall-clock "
+        f"guard {config.budget_s:g} s per cell). Rerun: `{ctx.rerun}`.",
         f"lawbench {version('lawbench')}, Python {platform.python_version()}, numpy "
         f"{np.__version__}, scipy {scipy.__version__}, matplotlib {matplotlib.__version__}.",
         *dict.fromkeys(f"Note: {note}." for note in ctx.notes),
-        *([f"Declared studies left out of this page: {left_out}."] if left_out else []),
+        Details(
+            f"The {len(ctx.laws)} laws, {len(ctx.cases)} scenes and {len(ctx.studies)} "
+            "studies of this run, and the declared studies left out: show",
+            listed,
+        ),
+    ]
+
+
+def answer_blocks(ctx: Context) -> list[Block]:
+    """The page's first screen: the answer table, one row per scene and per measured set."""
+    rows, aside = [], 0
+    for case, data, _ in tradeoff.scenes(ctx):
+        costs = answer.retime(case, data)
+        rows.append(answer.scene_row(case, data, costs, f"scene-{case.name}"))
+        aside += len(answer.set_aside(data))
+    for name, text in measured.closest_per_set(ctx).items():
+        rows.append(
+            {
+                "scene": f"set [{name}](#{measured.ANCHOR})",
+                "ground truth": "measured impacts (closest to measurement: held-out error)",
+                "closest law, model error": text,
+            }
+        )
+    if not rows:
+        return ["No speed/accuracy study and no measurement set ran: no answer to give."]
+    levels = ", ".join(f"{level:g}" for level in answer.LEVELS)
+    return [
+        f"Model error = {answer.ERROR}: the distance from the scene's ground truth relative to "
+        f"the largest pre-impact speed; the accuracy levels are {levels}.",
+        Table("answer", answer.caption(aside), pd.DataFrame(rows).fillna("")),
     ]

@@ -384,34 +384,29 @@ def set_blocks(study: MeasuredStudy, measurement_set: MeasurementSet) -> list[Bl
 
 
 def closest(study: MeasuredStudy) -> str:
-    """One line: the registered law closest to the set's measurements, error and interval."""
+    """The registered law closest to the set's measurements, its error and interval."""
     table = study.table
     laws = table[table["law"].isin(LAWS.names()) & table["median_error"].notna()]
     if laws.empty:
-        return f"`{study.set_name}`: no law answered"
+        return "no law answered"
     best = laws.iloc[0]
     return (
-        f"`{study.set_name}`: `{best['law']}` ({best['coefficients']} coefficients), held-out "
-        f"median error {number(best['median_error'])} (95% CI {number(best['ci_low'])}"
+        f"`{best['law']}` ({best['coefficients']} coefficients), held-out median error "
+        f"{number(best['median_error'])} (95% CI {number(best['ci_low'])}"
         f"–{number(best['ci_high'])}; {best['judged_on']})"
     )
 
 
-def first_screen(ctx: Context) -> str:
-    """The page's top line: per set, the law closest to measurement, linking to the section."""
+def closest_per_set(ctx: Context) -> dict[str, str]:
+    """Per measurement set, the law closest to measurement (`closest`) or why there is none."""
     try:
         found = results(ctx)
     except Exception as exc:  # the page keeps its top; the section shows the same error
-        return f"The studies against measurements failed: {type(exc).__name__}: {exc}."
-    parts = [
-        closest(study) if isinstance(study, MeasuredStudy) else f"`{name}`: study failed"
+        return {"every set": f"the studies failed: {type(exc).__name__}: {exc}"}
+    return {
+        name: closest(study) if isinstance(study, MeasuredStudy) else "study failed"
         for name, study in found.studies.items()
-    ]
-    listed = "; ".join(parts) or "no measurement set"
-    return (
-        f"Closest to measurement (fitted on each set's training impacts, judged on its test "
-        f"impacts): {listed}. [Against measurements](#{ANCHOR}) has every law."
-    )
+    }
 
 
 def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:

@@ -33,8 +33,12 @@ STYLE = """
 body { font-family: sans-serif; max-width: 1200px; margin: 2em auto; padding: 0 1em; }
 table { border-collapse: collapse; margin: 1em 0; font-size: 0.85em; }
 th, td { border: 1px solid #bbb; padding: 0.2em 0.5em; vertical-align: top; }
-th { background: #eee; overflow-wrap: anywhere; }
+th { background: #eee; overflow-wrap: normal; word-break: normal; hyphens: none; }
+.scroll { max-width: 100%; overflow-x: auto; }
 figure { margin: 1.5em 0; }
+details { margin: 0.5em 0; }
+summary { cursor: pointer; color: #225; }
+nav ol ol { columns: 3; font-size: 0.9em; }
 figure img { max-width: 100%; }
 figcaption, .caption { font-size: 0.9em; color: #333; }
 tr:target { background: #ffd; }
@@ -50,9 +54,11 @@ TEMPLATE = """<!doctype html>
 <body>
 <h1>{{ title }}</h1>
 {% for block in preamble %}{{ render(block) }}
-{% endfor %}<ol>{% for s in sections %}
-<li><a href="#{{ s.anchor }}">{{ s.title }}</a></li>{% endfor %}</ol>
-{% for s in sections %}<h2 id="{{ s.anchor }}">{{ s.title }}</h2>
+{% endfor %}<nav id="contents"><ol>{% for s, children in contents %}
+<li><a href="#{{ s.anchor }}">{{ s.title }}</a>{% if children %}<ol>{% for c in children %}
+<li><a href="#{{ c.anchor }}">{{ c.title }}</a></li>{% endfor %}</ol>{% endif %}</li>{% endfor %}
+</ol></nav>
+{% for s in sections %}<h{{ s.level }} id="{{ s.anchor }}">{{ s.title }}</h{{ s.level }}>
 {% for block in s.blocks %}{{ render(block) }}
 {% endfor %}{% endfor %}</body></html>
 """
@@ -60,11 +66,13 @@ PARTS = {
     "text": "<p>{{ block | inline }}</p>",
     "legend": '<p class="legend">{% for m in block.marks %}{{ mark(m) }}'
     "<span> {{ m.reason }}</span><br>{% endfor %}</p>",
-    "table": '<table id="{{ block.name }}"{% if block.css %} class="{{ block.css }}"{% endif %}>'
-    "<thead><tr>"
+    "details": "<details><summary>{{ block.summary | inline }}</summary>"
+    "{% for b in block.blocks %}{{ render(b) }}{% endfor %}</details>",
+    "table": '<div class="scroll"><table id="{{ block.name }}"'
+    '{% if block.css %} class="{{ block.css }}"{% endif %}><thead><tr>'
     "{% for c in block.frame.columns %}<th>{{ c }}</th>{% endfor %}</tr></thead><tbody>"
     '{% for row in rows %}<tr{% if row.anchor %} id="{{ row.anchor }}"{% endif %}>'
-    "{% for c in row.cells %}<td>{{ c }}</td>{% endfor %}</tr>{% endfor %}</tbody></table>"
+    "{% for c in row.cells %}<td>{{ c }}</td>{% endfor %}</tr>{% endfor %}</tbody></table></div>"
     '<p class="caption">{{ caption | inline }}</p>',
     "figure": '<figure id="{{ block.name }}"><a href="{{ block.name }}.svg">'
     '<img src="{{ block.name }}.svg" alt="{{ block.name }}"></a>'
@@ -81,7 +89,8 @@ class Table:
     """A table: ``frame`` is shown, ``data`` (default ``frame``) is written as CSV.
 
     ``anchors`` names a column whose values become the rows' anchors; ``commands`` the columns
-    of commands (shown as code, with the class ``reproducer``).
+    of commands (shown as code, with the class ``reproducer``); ``hidden`` the columns written
+    to the CSV but not shown.
     """
 
     name: str
@@ -91,6 +100,11 @@ class Table:
     anchors: str | None = None
     commands: tuple[str, ...] = ()
     css: str = ""
+    hidden: tuple[str, ...] = ()
+
+    def shown(self) -> pd.DataFrame:
+        """The columns the page shows."""
+        return self.frame.drop(columns=list(self.hidden))
 
 
 @dataclass
@@ -110,20 +124,51 @@ class Legend:
     marks: tuple[Mark, ...] = field(default_factory=lambda: tuple(legend()))
 
 
-Block = str | Table | Figure | Legend
+@dataclass
+class Details:
+    """Blocks folded under a one-line summary, open on a click."""
+
+    summary: str
+    blocks: list[Block] = field(default_factory=list)
+
+
+Block = str | Table | Figure | Legend | Details
+
+
+def flat(blocks: Sequence[Block]) -> list[Block]:
+    """The blocks with every `Details` replaced by its blocks, recursively."""
+    found: list[Block] = []
+    for block in blocks:
+        found += flat(block.blocks) if isinstance(block, Details) else [block]
+    return found
 
 
 @dataclass
 class Section:
-    """A numbered section: paragraphs (str), tables, figures and legends, in order."""
+    """A section: paragraphs (str), tables, figures, legends and folds, in order.
+
+    ``level`` is its heading's (2: a part of the page, 3: a section in it, 4: a topic of it).
+    """
 
     anchor: str
     title: str
     blocks: list[Block] = field(default_factory=list)
+    level: int = 2
 
     def figures(self) -> list[Figure]:
-        """The section's figures."""
-        return [b for b in self.blocks if isinstance(b, Figure)]
+        """The section's figures, folded ones included."""
+        return [b for b in flat(self.blocks) if isinstance(b, Figure)]
+
+
+def contents(sections: Sequence[Section]) -> list[tuple[Section, list[Section]]]:
+    """The parts of the page (level 2), each with its sections (level 3)."""
+    parts: list[tuple[Section, list[Section]]] = []
+    for section in sections:
+        if section.level == 2 or not parts:
+            parts.append((section, []))
+        elif section.level == 3:
+            parts[-1][1].append(section)
+    return parts
 
 
 def _inline(text: Any) -> Markup:
@@ -169,13 +214,17 @@ class _Html:
             return Markup(self.parts["text"].render(block=block))
         if isinstance(block, Legend):
             return Markup(self.parts["legend"].render(block=block, mark=self.mark))
+        if isinstance(block, Details):
+            return Markup(self.parts["details"].render(block=block, render=self.render))
         caption = _caption(block, self.rerun)
         if isinstance(block, Figure):
             return Markup(self.parts["figure"].render(block=block, caption=caption))
         rows = []
-        for _, row in block.frame.iterrows():
+        for (_, row), (_, whole) in zip(
+            block.shown().iterrows(), block.frame.iterrows(), strict=True
+        ):
             cells = [self.cell(v, c in block.commands) for c, v in row.items()]
-            anchor = str(row[block.anchors]) if block.anchors else ""
+            anchor = str(whole[block.anchors]) if block.anchors else ""
             rows.append({"anchor": anchor, "cells": cells})
         return Markup(self.parts["table"].render(block=block, rows=rows, caption=caption))
 
@@ -187,6 +236,7 @@ class _Html:
             style=Markup(STYLE),
             colours=colours,
             preamble=preamble,
+            contents=contents(sections),
             sections=sections,
             render=self.render,
         )
@@ -208,19 +258,21 @@ def _markdown(block: Block, rerun: str) -> str:
         return block
     if isinstance(block, Legend):
         return "Verdicts: " + "; ".join(m.markdown() + f" {m.reason}" for m in block.marks)
+    if isinstance(block, Details):
+        return "\n\n".join([f"**{block.summary}**", *(_markdown(b, rerun) for b in block.blocks)])
     caption = _caption(block, rerun)
     if isinstance(block, Figure):
         return f"![{block.name}]({block.name}.svg)\n\n{caption}"
-    frame = block.frame
+    frame = block.shown()
     lines = [
         f'<a id="{block.name}"></a>\n',
         "| " + " | ".join(map(str, frame.columns)) + " |",
         "|" + "---|" * len(frame.columns),
     ]
-    for _, row in frame.iterrows():
+    for (_, row), (_, whole) in zip(frame.iterrows(), block.frame.iterrows(), strict=True):
         cells = [_markdown_cell(v, c in block.commands) for c, v in row.items()]
         if block.anchors:
-            cells[0] = f'<a id="{row[block.anchors]}"></a>{cells[0]}'
+            cells[0] = f'<a id="{whole[block.anchors]}"></a>{cells[0]}'
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + f"\n\n{caption}"
 
@@ -278,7 +330,7 @@ def write_page(
     ``save`` writes the figures (for example in worker processes).
     """
     out.mkdir(parents=True, exist_ok=True)
-    blocks = [*preamble, *(b for s in sections for b in s.blocks)]
+    blocks = flat([*preamble, *(b for s in sections for b in s.blocks)])
     for block in blocks:
         if isinstance(block, Table):
             data = _plain(block.frame) if block.data is None else block.data
@@ -286,9 +338,12 @@ def write_page(
                 data.to_csv(temporary, index=False)
     _write_text(out / "index.html", _Html(rerun).page(title, preamble, sections))
     markdown = [f"# {title}", *(_markdown(b, rerun) for b in preamble)]
-    markdown += [f"{n}. [{s.title}](#{s.anchor})" for n, s in enumerate(sections, 1)]
+    for n, (part, children) in enumerate(contents(sections), 1):
+        markdown.append(f"{n}. [{part.title}](#{part.anchor})")
+        markdown += [f"    - [{c.title}](#{c.anchor})" for c in children]
     for section in sections:
-        markdown.append(f'<a id="{section.anchor}"></a>\n\n## {section.title}')
+        heading = "#" * section.level
+        markdown.append(f'<a id="{section.anchor}"></a>\n\n{heading} {section.title}')
         markdown += [_markdown(b, rerun) for b in section.blocks]
     _write_text(out / "report.md", "\n\n".join(markdown) + "\n")
     save([b for b in blocks if isinstance(b, Figure)], out)

@@ -10,15 +10,16 @@ repeats. Two measures, drawn on two panels:
 - *numerical error*: distance, the same way, from the law's own answer at its tightest knob
   (0 for an exact law; none for a knob that chooses an ordering, not an accuracy).
 
-The ground truth's own model is the reference and never a candidate. Over the laws under test the
-Pareto front (no point both cheaper and closer to the ground truth) is marked, and a table gives,
-one row per scene, the cheapest law whose model error reaches each level and a sentence that says
-which law to use and at what cost.
+The ground truth's own model is the reference and never a candidate. Over the laws under test
+whose cells hold (verdict holds or law property) the Pareto front (no point both cheaper and
+closer to the ground truth) is marked. Which law to use at what cost is the page's first table
+(`lawbench.views.report.answer`), read off the same points.
 """
 
 from __future__ import annotations
 
 import json
+import weakref
 from typing import Any
 
 import numpy as np
@@ -26,12 +27,12 @@ import pandas as pd
 
 from lawbench.core.case import Case
 from lawbench.views.report import plots
-from lawbench.views.report.page import Figure, Section, Table
+from lawbench.views.report.answer import candidates
+from lawbench.views.report.page import Figure, Section
 from lawbench.views.report.runs import Context, parsed
 from lawbench.views.report.summary import failure
 
 ANCHOR, TITLE, VIEWS = "tradeoff", "Speed versus accuracy", ("tradeoff",)
-LEVELS = (1e-2, 1e-4, 1e-6)
 MEASURES = {
     "model_error": "model error (vs the ground truth, relative)",
     "numerical_error": "numerical error (vs its tightest knob, relative)",
@@ -56,7 +57,15 @@ def points(ctx: Context, table: pd.DataFrame) -> pd.DataFrame:
         value = json.loads(options).get(knob) if knob else None
         first = group.iloc[0].to_dict()
         answered = group[group["error_class"] == ""]
-        row = {"law": law, "knob": knob or "", "value": value, "verdict": first["verdict"]}
+        row = {
+            "law": law,
+            "knob": knob or "",
+            "value": value,
+            "verdict": first["verdict"],
+            "options": options,
+            "params": first["params"],
+            "reproducer": first["reproducer"],
+        }
         if answered.empty:
             rows.append({**row, "failure": failure(first)})
             continue
@@ -67,11 +76,32 @@ def points(ctx: Context, table: pd.DataFrame) -> pd.DataFrame:
                 "steps": int(first["steps"]),
                 **{m: parsed(first.get(m)) for m in MEASURES},
                 "failure": "",
-                "reproducer": first["reproducer"],
             }
         )
     columns = ["law", "knob", "value", "wall_time_s", "steps", *MEASURES, "verdict", "failure"]
-    return pd.DataFrame(rows).reindex(columns=[*columns, "reproducer"])
+    return pd.DataFrame(rows).reindex(columns=[*columns, "options", "params", "reproducer"])
+
+
+_SCENES: weakref.WeakKeyDictionary[Context, list[tuple[Case, pd.DataFrame, int]]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def scenes(ctx: Context) -> list[tuple[Case, pd.DataFrame, int]]:
+    """Per speed/accuracy study that ran: its scene, its points and its repeats.
+
+    The points have a ``candidate`` column: False for the ground truth's own model.
+    """
+    if ctx not in _SCENES:
+        found = []
+        for study, table in ctx.tables("tradeoff"):
+            case = ctx.case(study.cases[0])
+            data = points(ctx, table)
+            truth = case.ground_truth
+            data["candidate"] = data["law"] != (truth.law if truth else None)
+            found.append((case, data, study.repeats))
+        _SCENES[ctx] = found
+    return _SCENES[ctx]
 
 
 def build(ctx: Context) -> Section:
@@ -82,34 +112,8 @@ def build(ctx: Context) -> Section:
         "ground truth, numerical error the distance from the law's own answer at its tightest "
         "knob. Both are max |v+ - v_ref| / max |v-|, dimensionless."
     ]
-    rows: list[dict[str, str]] = []
-    for study, table in ctx.tables("tradeoff"):
-        case = ctx.case(study.cases[0])
-        data = points(ctx, table)
-        truth = case.ground_truth
-        data["candidate"] = data["law"] != (truth.law if truth else None)
-        blocks += _scene_blocks(case, data, study.repeats)
-        rows.append(
-            {
-                "scene": case.name,
-                "ground truth": truth.describe() if truth else "none",
-                **{f"within {level:g}": _cheapest(data, level) for level in LEVELS},
-                "answer": sentence(case, data),
-            }
-        )
-    if rows:
-        frame = pd.DataFrame(rows)
-        blocks.append(
-            Table(
-                "tradeoff_cheapest",
-                "Which law, at what cost, one row per scene: the cheapest law under test (by "
-                "median wall time) whose model error, the distance from the scene's ground "
-                "truth, is within each level ('none' when no point of its sweep is), and the "
-                "answer in one sentence. The ground truth's own model is the reference, never "
-                "a candidate.",
-                frame,
-            )
-        )
+    for case, data, repeats in scenes(ctx):
+        blocks += _scene_blocks(case, data, repeats)
     return Section(ANCHOR, TITLE, blocks)
 
 
@@ -128,7 +132,7 @@ def _scene_blocks(case: Case, data: pd.DataFrame, repeats: int) -> list[Any]:
         ax.set(xlabel="median wall time [s]", ylabel=label)
         ax.set_ylim(bottom=plots.FLOOR / 10)
     data["pareto"] = False
-    known = measured[measured["model_error"].notna() & measured["candidate"]]
+    known = candidates(data)
     if len(known):
         errors = plots.floored(known["model_error"].astype(float))
         front = pareto(known["wall_time_s"].to_numpy(), errors)
@@ -150,7 +154,7 @@ def _scene_blocks(case: Case, data: pd.DataFrame, repeats: int) -> list[Any]:
         f"own answer at its tightest knob. The ground truth's model is drawn on the right "
         f"only: it is the reference, never a candidate. Cost: {cost}; an "
         f"error of 0 (an exact law against itself) drawn at {plots.FLOOR:g}; black circles: "
-        "the Pareto front of model error and cost over the laws under test."
+        "the Pareto front of model error and cost over the cells of the laws under test that hold."
     )
     failed = data[data["failure"] != ""]
     notes = dict.fromkeys(
@@ -158,53 +162,3 @@ def _scene_blocks(case: Case, data: pd.DataFrame, repeats: int) -> list[Any]:
         for r in failed.itertuples()
     )
     return [Figure(f"tradeoff_{case.name}", caption, fig, data), *notes]
-
-
-def _measured(data: pd.DataFrame) -> pd.DataFrame:
-    """The candidates' points that have a model error."""
-    return data[data["candidate"] & (data["failure"] == "") & data["model_error"].notna()]
-
-
-def _within(data: pd.DataFrame, level: float) -> pd.Series | None:
-    """The cheapest candidate point whose model error is at most ``level``, or None."""
-    known = _measured(data)
-    reached = known[known["model_error"].astype(float) <= level].sort_values("wall_time_s")
-    return None if reached.empty else reached.iloc[0]
-
-
-def _cheapest(data: pd.DataFrame, level: float) -> str:
-    best = _within(data, level)
-    if best is None:
-        return "none"
-    knob = f" ({best['knob']}={best['value']})" if best["knob"] else ""
-    return f"{best['law']}{knob}, {best['wall_time_s']:.2g} s"
-
-
-def _duration(seconds: float) -> str:
-    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6)):
-        if seconds >= scale:
-            return f"{seconds / scale:.3g} {unit}"
-    return f"{seconds / 1e-9:.3g} ns"
-
-
-def sentence(case: Case, data: pd.DataFrame) -> str:
-    """Which law to use on the scene, at what cost, read off its speed/accuracy points."""
-    known = _measured(data)
-    if known.empty:
-        return f"No law under test has a model error on {case.name}."
-    errors = known["model_error"].astype(float)
-    closest = known.loc[errors.idxmin()]
-    words = [
-        f"{closest['law']} comes closest, within {float(closest['model_error']):.2g} at "
-        f"{_duration(float(closest['wall_time_s']))}"
-    ]
-    for level in LEVELS:
-        best = _within(data, level)
-        if best is None:
-            words.append(f"no law under test is within {level:g}")
-            break
-        words.append(
-            f"the cheapest within {level:g} is {best['law']} at "
-            f"{_duration(float(best['wall_time_s']))}"
-        )
-    return "; ".join(words) + "."
