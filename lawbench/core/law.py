@@ -24,7 +24,7 @@ and a `MemoryError` are a `SolverFailure` of that law; so are an answer that is 
 whose ``v_plus``, ``Pn`` or ``Pt`` has the wrong length, a problem or options the law wrote into
 (a digest taken before and after: for a law from outside lawbench's own packages it hashes
 every number of the problem; for lawbench's own, whose tests hold them to their inputs, it
-checks that the problem's read-only arrays are the same and still read-only), and reported
+checks that the problem holds the same read-only arrays and frozen contacts), and reported
 numbers that disagree with the answer's own velocities: ``T_minus`` and ``T_plus`` against
 ``v @ M @ v / 2``, and the impulses against the velocity change, ``Wn Pn + Wt Pt = M (v+ - v-)``,
 each beyond its rounding (`lawbench.core.guards`).
@@ -561,13 +561,13 @@ class _Watch:
 
     def __init__(self, law: str, options: dict[str, Any]) -> None:
         self.budget = Budget.of(law, options)
-        self.warnings = warnings.catch_warnings(record=True)
+        # Every warning recorded, none printed: the filter "always" ahead of the caller's.
+        self.warnings = warnings.catch_warnings(record=True, action="always")
         self.record: dict[str, Any] = {"options": options}
 
     def __enter__(self) -> _Watch:
         self.budget.__enter__()
         self.caught = self.warnings.__enter__()
-        warnings.simplefilter("always")
         self.start = time.perf_counter()
         return self
 
@@ -575,9 +575,9 @@ class _Watch:
         self.record["wall_time_s"] = time.perf_counter() - self.start
         self.warnings.__exit__(*exc)
         self.budget.__exit__(*exc)
-        heard = sorted({f"{w.category.__name__}: {w.message}" for w in self.caught})
-        if heard:
-            self.record["warnings"] = heard
+        if self.caught:
+            heard = {f"{w.category.__name__}: {w.message}" for w in self.caught}
+            self.record["warnings"] = sorted(heard)
 
 
 LAWS: Registry[Law] = Registry("law", "lawbench.laws", Law)
