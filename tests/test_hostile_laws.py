@@ -137,6 +137,24 @@ def test_a_law_that_exits_runs_out_of_memory_or_writes_into_its_input_fails(body
         lawbench.solve(broken(body), ball())
 
 
+def test_lawbench_s_own_laws_still_have_their_options_and_problem_identity_checked():
+    """A law of lawbench's own packages skips the hash of the numbers (its arrays are
+    read-only), not the check of its options, nor of which arrays the problem holds."""
+    own = broken(_writes_options)
+    type(own).__module__ = "lawbench.laws.own_test_law"
+    with pytest.raises(SolverFailure, match="wrote into the options"):
+        lawbench.solve(own, ball())
+
+    def swaps_velocity(self, problem, options):
+        object.__setattr__(problem, "v", problem.v.copy())
+        return Plain._resolve(self, problem, options)
+
+    own = broken(swaps_velocity)
+    type(own).__module__ = "lawbench.laws.own_test_law"
+    with pytest.raises(SolverFailure, match="wrote into the problem"):
+        lawbench.solve(own, ball())
+
+
 @pytest.mark.parametrize("field", ["v_plus", "Pn"])
 def test_a_wrong_output_shape_names_the_field(field):
     def wrong(self, problem, options):

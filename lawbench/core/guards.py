@@ -244,17 +244,26 @@ def _checksum(arrays: tuple[Any, ...]) -> int:
     return hash(tuple(parts))
 
 
-def inputs(problem: ImpactProblem, options: dict[str, Any]) -> tuple[tuple, tuple]:
+def inputs(
+    problem: ImpactProblem, options: dict[str, Any], checksum: bool = True
+) -> tuple[tuple, dict[str, Any]]:
     """A digest of what a law receives, to compare before and after its solve.
 
-    The problem's part and the options' part, so that a change names which it is.
+    The problem's part and the options' part (a copy of the options), so that a change names
+    which it is. The problem's arrays are read-only (`ImpactProblem`) and its fields frozen, so
+    no law writes into them by accident; only a law that makes an array writeable again can.
+    ``checksum`` (for a law from outside lawbench's own packages) adds the hash of every number
+    and contact, which catches that law. Without it (lawbench's own laws, whose tests hold them
+    to their inputs) the problem's part is which arrays and contacts the problem holds.
     """
-    arrays = (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps)
+    held = (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps, problem.contacts)
+    if not checksum:
+        return tuple(map(id, held)), dict(options)
     try:
         contacts: object = hash(problem.contacts)
     except TypeError:  # a contact given an unhashable field
         contacts = repr(problem.contacts)
-    return (*map(id, arrays), _checksum(arrays), contacts), (*options, *map(id, options.values()))
+    return (*map(id, held), _checksum(held[:-1]), contacts), dict(options)
 
 
 def verify_answer(law: str, problem: ImpactProblem, outcome: Any) -> None:
@@ -277,24 +286,24 @@ def verify_answer(law: str, problem: ImpactProblem, outcome: Any) -> None:
             shape = np.shape(getattr(outcome, field))
             if shape != (length,) and not (field == "Pt" and shape == (0,)):
                 raise SolverFailure(f"{law}: {field} has shape {shape}, expected ({length},)")
-    after, before = problem.M.dot(v_plus), problem.momentum
+    before, after = problem.momentum, problem.M.dot(v_plus)
     impulse = generalized_impulse(problem, Pn, Pt)
-    residual = impulse - (after - before)
-    T_plus, told_minus, told_plus = float(v_plus.dot(after)) / 2, outcome.T_minus, outcome.T_plus
+    residual = impulse - after + before
+    # Python floats from here: numpy's scalars cost more than its small products.
+    T_plus, T_minus = float(v_plus.dot(after)) / 2, problem.T_minus
+    told_minus, told_plus = outcome.T_minus, outcome.T_plus
     # Squared 2-norms: dot products, the cheapest reductions of a small solve.
-    scale = after.dot(after) + before.dot(before) + impulse.dot(impulse)
+    scale = float(after.dot(after)) + float(before.dot(before)) + float(impulse.dot(impulse))
     if not math.isfinite(scale + told_minus + told_plus):
         refuse_non_finite(law, v_plus=v_plus, Pn=Pn, Pt=Pt, T_plus=float(told_plus))
         return  # finite numbers so large that their squares overflow: beyond these checks
-    for field, told, kept in (
-        ("T_minus", told_minus, problem.T_minus),
-        ("T_plus", told_plus, T_plus),
-    ):
-        if abs(told - kept) > CONSISTENCY * max(T_plus, problem.T_minus):
+    energy = CONSISTENCY * max(T_plus, T_minus)
+    for field, told, kept in (("T_minus", told_minus, T_minus), ("T_plus", told_plus, T_plus)):
+        if abs(told - kept) > energy:
             raise SolverFailure(
                 f"{law}: reports {field} = {told:.6g} J where its velocities hold {kept:.6g} J"
             )
-    if residual.dot(residual) > CONSISTENCY**2 * scale:
+    if float(residual.dot(residual)) > CONSISTENCY * CONSISTENCY * scale:
         raise SolverFailure(
             f"{law}: its impulses Wn Pn + Wt Pt do not give its velocity change M (v+ - v-)"
         )
