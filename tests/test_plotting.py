@@ -75,7 +75,7 @@ def test_plot_path_draws_each_component_against_the_impact_variable(ax, law, cas
 def test_plot_path_names_what_is_missing():
     with pytest.raises(lawbench.InvalidProblem, match="path=True"):
         lawbench.plot_path(lawbench.solve("lzb", "three_ball_chain"))
-    with pytest.raises(lawbench.InvalidProblem, match="no 'colour'; it holds t, Pn"):
+    with pytest.raises(lawbench.InvalidProblem, match="no 'colour'; it holds Pn_sum, t, Pn"):
         lawbench.plot_path(lawbench.solve("lzb", "three_ball_chain", {"path": True}), "colour")
 
 
