@@ -37,8 +37,8 @@ class PowersOfTen(LogFormatter):
     Matplotlib's default labels are TeX-like, and laying them out took most of a report figure's
     drawing time. The major ticks' formatter labels decades; the minor ticks' one (``minor``)
     labels nothing on an axis that spans a decade or more, 2 and 5 times a power of ten on a
-    shorter one, and every multiple below 0.4 of a decade: labelled at 2, 3, 4 and 6 over a
-    decade, ``3×10⁻³`` ran into ``4×10⁻³``.
+    shorter one, and 2, 3, 5 and 7 times below 0.4 of a decade: labels at least 0.14 decade
+    apart, where 2, 3, 4 and 6 over a decade ran ``3×10⁻³`` into ``4×10⁻³``.
     """
 
     def __init__(self, minor: bool = False) -> None:
@@ -51,11 +51,13 @@ class PowersOfTen(LogFormatter):
             return
         low, high = sorted(abs(v) for v in self.axis.get_view_interval())
         decades = math.log10(high / low) if low > 0 else math.inf
-        self._sublabels = set() if decades >= 1 else {2, 5} if decades >= 0.4 else set(range(10))
+        self._sublabels = set() if decades >= 1 else {2, 5} if decades >= 0.4 else {2, 3, 5, 7}
 
     def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
         exponent = math.floor(math.log10(x) + 1e-9)
         coefficient = round(x / 10.0**exponent)
+        if not math.isclose(x, coefficient * 10.0**exponent, rel_tol=1e-6):
+            return ""  # a tick between multiples (2.5×10⁻⁴) would read as its neighbour's
         power = "10" + str(exponent).translate(SUPERSCRIPTS)
         return power if coefficient == 1 else f"{coefficient}×{power}"
 
