@@ -5,6 +5,10 @@ names the two parameters its map spans (and the example it starts from). Every l
 treat the scene is solved on the grid; its relative energy change ``dT / T-`` is mapped, and
 beside it the verdict of each cell (the energy-gain check: a gain the law's findings predict is
 a *law property*, any other gain is not). A table gives, per law, where it gains energy.
+
+Two laws a row (each law's map and its verdicts side by side) keep a figure as wide as the page,
+its labels readable; the colour scale is the scene's own, symmetric and logarithmic beyond
+``LINEAR``, so that one law's gain of 8 does not wash out another's change of 1e-2.
 """
 
 from __future__ import annotations
