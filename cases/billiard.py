@@ -18,14 +18,19 @@ and tangents x and y: gap rate ``vz``, slip ``(vx - R wy, vy + R wx)``. Before t
 ball is at rest on the table (contact 2 closed, neither approaching nor separating) and the cue
 moves at ``speed``.
 
-Parameters (defaults, a pool table): ball ``mass`` 0.17 kg and ``radius`` 0.028575 m (57.15 mm
-diameter), ``cue_mass`` 0.54 kg, ``speed`` 3 m/s, ``elevation`` 0 degrees, offsets 0 m; per
-contact (cue-ball, ball-table): ``e`` (0.8, 0.5), ``mu`` (0.6, 0.2) (a chalked tip, cloth),
-``stiffness_ratio`` 1 (ball-table over cue-ball) and ``exponent`` 1.5.
+Parameters (defaults, a masse shot on a pool table): ball ``mass`` 0.17 kg and ``radius``
+0.028575 m (57.15 mm diameter), ``cue_mass`` 0.54 kg, ``speed`` 3 m/s, ``elevation`` 70
+degrees, ``offset_side`` 12 mm and ``offset_height`` 5 mm; per contact (cue-ball, ball-table):
+``e`` (0.8, 0.5), ``mu`` (0.6, 0.2) (a chalked tip, cloth), ``stiffness_ratio`` 1 (ball-table
+over cue-ball) and ``exponent`` 1.5.
 
 Source: Jia, *Energy-based modeling of tangential compliance in 3-dimensional impact* (2012
 talk) and Jia, Mason and Erdmann, IJRR 32(1) (2013): the billiard shot as two simultaneous
-contacts whose normal impulses drive the tangential ones; the masse shot at a steep elevation.
+contacts whose normal impulses drive the tangential ones, the example being the masse shot of
+a mechanical cue stick at a steep elevation, struck off the centre. The talk gives no numbers
+for it; the defaults are a steep masse stroke as players play it (cue about 70 degrees up, the
+tip under half a radius off the centre), where the cue presses the ball into the cloth and
+both contacts take friction. The straight shot below is the example ``straight``.
 
 Straight shot: horizontal and through the centre, the cue's normal (x) and the table's (z) are
 orthogonal in the kinetic metric and no contact point slips, so friction cannot act and the
@@ -111,11 +116,11 @@ class Billiard(Case):
         _specs.positive("radius", 0.028575, "ball radius", "m"),
         _specs.positive("cue_mass", 0.54, "cue mass", "kg"),
         _specs.positive("speed", 3.0, "cue speed along its axis", "m/s"),
-        Spec("elevation", 0.0, "cue elevation above the table", unit="deg", low=0.0, high=89.0),
-        Spec("offset_side", 0.0, "sideways offset of the cue's axis (english)", unit="m"),
+        Spec("elevation", 70.0, "cue elevation above the table", unit="deg", low=0.0, high=89.0),
+        Spec("offset_side", 0.012, "sideways offset of the cue's axis (english)", unit="m"),
         Spec(
             "offset_height",
-            0.0,
+            0.005,
             "offset of the cue's axis perpendicular to it, upward (follow > 0, draw < 0)",
             unit="m",
         ),
@@ -140,8 +145,8 @@ class Billiard(Case):
     )
     examples = {
         "default": {},
-        "side spin": {"offset_side": 0.01},
-        "masse": {"elevation": 70.0, "offset_side": 0.012, "offset_height": 0.005},
+        "straight": {"elevation": 0.0, "offset_side": 0.0, "offset_height": 0.0},
+        "side spin": {"elevation": 0.0, "offset_side": 0.01, "offset_height": 0.0},
     }
 
     def _check(self, params: dict[str, Any]) -> None:
@@ -305,7 +310,7 @@ Billiard.studies = (
         "table (degrees) and the curvature of its path on the cloth (1/m) against the cue's "
         "elevation (degrees)",
         "grid": {"elevation": [0.0, 30.0, 60.0, 75.0]},
-        "params": {"offset_side": 0.012},
+        "params": {"offset_side": 0.012, "offset_height": 0.0},
         "measures": MEASURES,
         "axes": ("elevation",),
         "units": UNITS,
@@ -318,7 +323,7 @@ Billiard.studies = (
         "spin (rad/s), spin-axis tilt (degrees) and path curvature (1/m) against the cue's "
         "sideways offset (m), -12 mm (left english) to 12 mm",
         "grid": {"offset_side": [-0.012, 0.0, 0.012]},
-        "params": {"elevation": 60.0},
+        "params": {"elevation": 60.0, "offset_height": 0.0},
         "measures": MEASURES,
         "axes": ("offset_side",),
         "units": UNITS,

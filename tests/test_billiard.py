@@ -1,5 +1,6 @@
 """The billiard shot: geometry of the two contacts, the straight shot, the masse shot."""
 
+import json
 import math
 
 import numpy as np
@@ -7,8 +8,10 @@ import pytest
 
 import lawbench
 from lawbench.cases.billiard import cue_geometry
+from lawbench.views.cli import main
 
 CASE = lawbench.CASES.get("billiard")
+STRAIGHT = CASE.examples["straight"]
 
 
 @pytest.mark.parametrize(
@@ -44,24 +47,36 @@ def test_the_straight_shot_is_the_frictionless_binary_impact():
     """Horizontal, through the centre: no contact point slips and the two normals are
     orthogonal in the kinetic metric, so friction cannot act; the cue's impulse is
     P = (1 + e) u m mc / (m + mc) (Newton's binary impact), no spin, whatever mu."""
-    params = CASE.parameters()
+    params = CASE.parameters(**STRAIGHT)
     m, mc, u, e = params["mass"], params["cue_mass"], params["speed"], params["e"][0]
     impulse = (1 + e) * u * m * mc / (m + mc)
     expected = [u - impulse / mc, impulse / m, 0, 0, 0, 0, 0]
     for mu in ([0.6, 0.2], [0.0, 0.0]):
-        outcome = lawbench.solve("moreau", "billiard", mu=mu)
+        outcome = lawbench.solve("moreau", "billiard", mu=mu, **STRAIGHT)
         np.testing.assert_allclose(outcome.v_plus, expected, atol=1e-9)
 
 
 def test_a_masse_shot_spins_the_ball_about_a_tilted_axis():
-    """A steep cue struck off the centre presses the ball into the table: both contacts take
-    friction and the spin axis is neither vertical nor horizontal (Jia 2012, the masse shot)."""
-    outcome = lawbench.solve("moreau", "billiard", **CASE.examples["masse"])
+    """The default shot, a steep cue struck off the centre, presses the ball into the table:
+    both contacts take friction and the spin axis is neither vertical nor horizontal (Jia
+    2012, the masse shot)."""
+    outcome = lawbench.solve("moreau", "billiard")
     w = outcome.v_plus[4:]
     tilt = math.degrees(math.asin(abs(w[2]) / np.linalg.norm(w)))
     assert 10.0 < tilt < 80.0
     assert outcome.Pn[1] > 0 and np.linalg.norm(outcome.Pt[2:]) > 0
     assert outcome.dT < 0
+
+
+def test_jia_solves_the_default_shot_with_friction_at_both_contacts(capsys):
+    """`lawbench solve jia billiard`: the masse shot's cue grips the ball and the ball slides
+    on the cloth, so both contacts take a tangential impulse, each inside its cone."""
+    assert main(["solve", "jia", "billiard", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    Pn, Pt = np.array(record["Pn"]), np.reshape(record["Pt"], (2, 2))
+    mu = CASE.parameters()["mu"]
+    for j in range(2):
+        assert 1e-3 * Pn[j] < np.linalg.norm(Pt[j]) <= mu[j] * Pn[j] * (1 + 1e-9), j
 
 
 def test_a_cue_that_misses_the_ball_is_refused():
@@ -93,11 +108,10 @@ def test_english_alone_runs_straight_and_a_masse_shot_curves():
         law = lawbench.LAWS.get("moreau")
         return path_curvature(Trial(law, CASE, params, {}, problem, outcome, {}))
 
-    assert curvature(offset_side=0.01) == pytest.approx(0.0, abs=1e-9)
-    masse = CASE.examples["masse"]
-    bent = curvature(**masse)
+    assert curvature(**CASE.examples["side spin"]) == pytest.approx(0.0, abs=1e-9)
+    bent = curvature()
     assert abs(bent) > 0.1
-    assert curvature(**{**masse, "offset_side": -masse["offset_side"]}) == pytest.approx(-bent)
+    assert curvature(offset_side=-CASE.parameters()["offset_side"]) == pytest.approx(-bent)
 
 
 @pytest.mark.parametrize("law", ["moreau", "jia", "compliant"])
@@ -109,7 +123,7 @@ def test_the_path_on_the_cloth_hops_slides_on_a_parabola_and_rolls(law):
     from lawbench.cases.billiard import table_path
     from lawbench.core.trial import Trial
 
-    params = CASE.parameters(**CASE.examples["masse"])
+    params = CASE.parameters()
     problem = CASE.build(**params)
     outcome = lawbench.LAWS.get(law).resolve(problem)
     trial = Trial(lawbench.LAWS.get(law), CASE, params, {}, problem, outcome, {})

@@ -29,15 +29,20 @@ FCLIB = sorted((Path(__file__).parent / "data" / "fclib").glob("*.hdf5"))
 FRICTIONAL = [name for name, case in CASES.items() if case.requires.friction]
 # Scenes where Coulomb's law has several solutions: both methods must solve it, each its own.
 SEVERAL_SOLUTIONS = {
-    ("billiard", 1.0): "the cue ball either stops both balls by friction or passes between "
-    "them; both satisfy De Saxce's conditions to rounding",
+    ("billiard", 1.0): "the straight shot's ball either wedges between cue and table by "
+    "friction or leaves along the cue; both satisfy De Saxce's conditions to rounding",
 }
+
+
+# The shot whose two answers at mu = 1 are known (the default is a masse shot, with one answer).
+SHOTS = {"billiard": CASES["billiard"].examples["straight"]}
 
 
 def with_friction(name, mu):
     """The scene built with every friction coefficient it has set to ``mu``."""
     case = CASES[name]
-    return case.build(**{p.name: mu for p in case.params if p.name.split("_")[0] == "mu"})
+    frictions = {p.name: mu for p in case.params if p.name.split("_")[0] == "mu"}
+    return case.build(**SHOTS.get(name, {}), **frictions)
 
 
 def impulses(outcome):

@@ -75,7 +75,7 @@ def test_plot_path_draws_each_component_against_the_impact_variable(ax, law, cas
 def test_plot_path_names_what_is_missing():
     with pytest.raises(lawbench.InvalidProblem, match="path=True"):
         lawbench.plot_path(lawbench.solve("lzb", "three_ball_chain"))
-    with pytest.raises(lawbench.InvalidProblem, match="no 'colour'; it holds t, Pn"):
+    with pytest.raises(lawbench.InvalidProblem, match="no 'colour'; it holds Pn_sum, t, Pn"):
         lawbench.plot_path(lawbench.solve("lzb", "three_ball_chain", {"path": True}), "colour")
 
 
@@ -100,3 +100,17 @@ def test_without_axes_each_draws_on_a_new_figure(run_table):
     assert len({id(ax.figure) for ax in drawn}) == len(drawn)
     assert all(ax.patches or ax.lines for ax in drawn)
     plt.close("all")
+
+
+def test_no_legend_sits_on_its_axes(run_table):
+    outcome = lawbench.solve("lzb", "three_ball_chain", {"path": True})
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.5), layout="tight")
+    lawbench.plot_outcome(outcome, ax=axes[0])
+    lawbench.plot_path(outcome, ax=axes[1])
+    lawbench.plot_sweep(run_table, "e", "dT", ax=axes[2])
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    for ax in axes:
+        box = ax.get_legend().get_window_extent(renderer)
+        assert not any(box.overlaps(other.get_window_extent(renderer)) for other in axes)
+    plt.close(fig)

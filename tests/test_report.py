@@ -68,7 +68,9 @@ def test_the_pareto_front_keeps_the_points_nothing_beats():
 
 
 def test_log_axes_are_labelled_in_plain_text_powers_of_ten():
-    """Decades read 10⁻⁶, the multiples within a decade 2×10⁻⁶: no TeX markup to lay out."""
+    """Decades read 10⁻⁶, the multiples within a decade 2×10⁻⁶: no TeX markup to lay out.
+
+    Below a decade only 2 and 5 times a power of ten are labelled, so labels never collide."""
     fig, axes = figure(1, 1)
     ax = axes[0, 0]
     ax.plot([1e-6, 1e-3], [2e-6, 8e-6])
@@ -77,7 +79,7 @@ def test_log_axes_are_labelled_in_plain_text_powers_of_ten():
     decades = [t.get_text() for t in ax.get_xticklabels()]
     within = [t.get_text() for t in ax.get_yticklabels(minor=True)]
     assert {"10⁻⁶", "10⁻⁵", "10⁻⁴", "10⁻³"} <= set(decades)
-    assert {"2×10⁻⁶", "3×10⁻⁶", "4×10⁻⁶", "6×10⁻⁶"} <= set(within)
+    assert {"2×10⁻⁶", "5×10⁻⁶"} == set(within) - {""}
     assert all("$" not in label for label in decades + within)
 
 

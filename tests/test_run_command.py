@@ -201,3 +201,20 @@ def test_an_installation_without_extras_solves_and_names_what_is_missing(
     assert result.returncode == status, result.stderr
     assert re.search(said, result.stdout + result.stderr)
     assert "Traceback" not in result.stderr
+
+
+def test_the_summary_counts_refused_cells_apart_from_failed_ones(tmp_path):
+    """Brach's law treats one contact: it refuses two balls on a wall (NotApplicable), which is
+    no failure; sequential impacts out of steps are one. The time goes to stderr."""
+    grid = ("--laws", "newton,brach,sequential", "--cases", "two_balls_wall", "--param", "e=0")
+    done = lawbench(
+        "run", *grid, "--option", "sequential.max_steps=5", "--executor", "serial",
+        "--out", "r.parquet", cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == (
+        "3 rows in r.parquet (3 computed now, 1 refused, 1 failed)"
+    )
+    number = r"\d[\d.e+-]*"
+    last = done.stderr.splitlines()[-1]
+    assert re.fullmatch(rf"run: 3 rows computed in {number} s, {number} rows/s", last), last

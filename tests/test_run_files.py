@@ -5,6 +5,7 @@ import random
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import pandas as pd
@@ -130,6 +131,37 @@ def test_a_waiting_run_takes_the_lock_when_the_first_ends(tmp_path):
         assert waiting.poll() is None
     assert waiting.wait(timeout=120) == 0
     assert len(lawbench.load_run(tmp_path / "w.parquet")) == CELLS
+
+
+def test_a_run_leaves_no_lock_file_behind(tmp_path):
+    assert lawbench_run("--out", "clean.parquet", cwd=tmp_path).returncode == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clean.parquet"]
+
+
+def test_a_run_that_waited_on_a_removed_lock_file_still_holds_the_output_alone(tmp_path):
+    """The first run removes the lock's name as it ends; the run waiting on that file gets its
+    lock, sees the name gone, and locks the name anew: a third run is still refused."""
+    first, second = Store(tmp_path / "o.parquet"), Store(tmp_path / "o.parquet")
+    held = threading.Event()
+    release = threading.Event()
+
+    def wait_then_hold():
+        with second.locked(wait=True):
+            held.set()
+            release.wait(30)
+
+    waiter = threading.Thread(target=wait_then_hold)
+    with first.locked():
+        waiter.start()
+        time.sleep(0.5)
+        assert not held.is_set()
+    assert held.wait(30)
+    with pytest.raises(lawbench.InvalidProblem, match="is locked by another run"):
+        with Store(tmp_path / "o.parquet").locked():
+            pass
+    release.set()
+    waiter.join(30)
+    assert not (tmp_path / "o.parquet.lock").exists()
 
 
 def test_resume_of_a_finished_run_says_it_is_complete(tmp_path):

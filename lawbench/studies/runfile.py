@@ -1,9 +1,11 @@
 """The files of a run: its lock, its checksummed chunks, and its tidy table with metadata.
 
-A run writing ``OUT`` holds the lock ``OUT.lock`` (`filelock`) from its first read to its last
-write, and names itself in ``OUT.lock.owner`` (process, machine, start time, command), so a
-second run on the same output stops with that name, or waits for the lock. The lock file stays
-after the run: deleting a lock file another process may be opening would break the lock.
+A run writing ``OUT`` holds the lock ``OUT.lock`` (``flock`` on the file) from its first read to
+its last write, and names itself in ``OUT.lock.owner`` (process, machine, start time, command),
+so a second run on the same output stops with that name, or waits for the lock. The run removes
+both files as it ends, the lock's name before its lock: a run that waited on the removed file
+gets its lock, finds the name gone or naming another file, and locks the name anew, so two runs
+never hold the output at once and no lock file is left behind.
 
 Finished cells go to ``OUT.parts/part-NNNNNN.parquet`` in chunks, each written under a
 temporary name and moved in place (`os.replace`) after its SHA-256 sidecar
@@ -24,6 +26,7 @@ CSV expands a vector into ``v_plus_0, v_plus_1, ...`` and keeps the metadata in 
 from __future__ import annotations
 
 import datetime
+import fcntl
 import hashlib
 import importlib.metadata
 import json
@@ -43,7 +46,6 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.feather as feather
 import pyarrow.parquet as pq
-from filelock import FileLock, Timeout
 
 from lawbench.core.errors import InvalidProblem
 from lawbench.core.verdicts import Verdict
@@ -228,6 +230,30 @@ def _sidecar(path: Path) -> Path:
     return path.with_name(path.name + ".meta.json")
 
 
+def _lock(path: Path, wait: bool) -> int:
+    """A descriptor of ``path`` holding its exclusive ``flock``.
+
+    Raises `BlockingIOError` when another process holds it and ``wait`` is False. A lock taken
+    on a file whose name was removed or reused meanwhile (its holder ended) is let go and taken
+    again on the file the name now gives.
+    """
+    while True:
+        descriptor = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+            held = os.fstat(descriptor)
+            try:
+                named = os.stat(path)
+            except FileNotFoundError:
+                named = None
+        except BaseException:
+            os.close(descriptor)
+            raise
+        if named is not None and os.path.samestat(held, named):
+            return descriptor
+        os.close(descriptor)
+
+
 def _atomic_text(path: Path, text: str) -> None:
     # A command line may hold a file name that is not UTF-8: escaped, never refused.
     with replaced(path, "run file") as temporary:
@@ -379,18 +405,17 @@ class Store:
     @contextmanager
     def locked(self, wait: bool = False) -> Iterator[None]:
         """Hold the output's lock; without ``wait``, a held lock raises `InvalidProblem`."""
-        lock = FileLock(self.lock_path, timeout=-1 if wait else 0)
         try:
             # Creating the lock file is the first write: a folder that cannot be written (read
             # only, full, under /sys) is known before any cell is computed.
             self.out.parent.mkdir(parents=True, exist_ok=True)
-            lock.acquire()
-        except Timeout:
+            descriptor = _lock(self.lock_path, wait)
+        except BlockingIOError:
             raise InvalidProblem(
                 f"--out {self.out} is locked by another run ({self._owner()}; lock file "
                 f"{self.lock_path}): wait for it with --wait, or choose another --out"
             ) from None
-        except OSError as exc:  # after Timeout, which is one
+        except OSError as exc:
             raise write_error(exc, "--out", self.out) from None
         try:
             started = datetime.datetime.now().isoformat(timespec="seconds")
@@ -399,7 +424,8 @@ class Store:
             yield
         finally:
             self.owner_path.unlink(missing_ok=True)
-            lock.release()
+            self.lock_path.unlink(missing_ok=True)
+            os.close(descriptor)  # releases the lock, after its name is gone
 
     def _owner(self) -> str:
         try:

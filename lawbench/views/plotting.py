@@ -10,7 +10,8 @@ None, and returns the axes, so figures compose::
     lawbench.plot_path(lawbench.solve("lzb", "three_ball_chain", {"path": True}), ax=right)
 
 Colours, markers and unit labels are the report's (`lawbench.views.report.plots`): a law has the
-same colour here as in every figure of the report.
+same colour here as in every figure of the report. A legend sits right of its axes, never on
+them (a figure laid out ``tight`` or ``constrained`` makes room for it).
 """
 
 from __future__ import annotations
@@ -49,6 +50,11 @@ def _axes(ax: Axes | None) -> Axes:
     import matplotlib.pyplot as plt
 
     return plt.figure().add_subplot()
+
+
+def _legend(ax: Axes, **options: Any) -> None:
+    """The legend of ``ax`` beside it, right of the axes: it never hides a curve or a label."""
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0), **options)
 
 
 def _outcome(result: Outcome | Trial) -> Outcome:
@@ -97,7 +103,7 @@ def plot_outcome(
     unit = units.pop() if len(units) == 1 else ""  # coordinates of several units share no unit
     ax.set_ylabel(f"velocity [{unit}]" if unit else "velocity")
     ax.set_title(f"T- = {result.T_minus:.4g} J, T+ = {result.T_plus:.4g} J")
-    ax.legend(fontsize="small")
+    _legend(ax)
     return ax
 
 
@@ -138,7 +144,7 @@ def plot_path(outcome: Outcome | Trial, key: str = "stored_energy", ax: Axes | N
     ax.set_xlabel(_quantity(x_key))
     ax.set_ylabel(_quantity(key))
     if values.shape[1] > 1:
-        ax.legend(fontsize="small")
+        _legend(ax)
     return ax
 
 
@@ -186,7 +192,7 @@ def plot_sweep(
     units = _units(frame)
     ax.set_xlabel(plots.unit_label(x, units))
     ax.set_ylabel(plots.unit_label(y, units))
-    ax.legend(fontsize="small", title=by)
+    _legend(ax, title=by)
     return ax
 
 
@@ -255,5 +261,5 @@ def plot_profiles(ratios: Mapping[str, Sequence[float]], ax: Axes | None = None)
     ax.set_ylabel("share of problems solved within tau")
     ax.set_ylim(0.0, 1.05)
     if ratios:
-        ax.legend(fontsize="small", loc="lower right")
+        _legend(ax)
     return ax

@@ -300,7 +300,12 @@ def _describe(
 
 
 def _path(impact: EnergeticImpact, problem: ImpactProblem) -> dict[str, np.ndarray]:
-    """Quantities at every kept state, in physical units."""
+    """Quantities at every kept state, in physical units.
+
+    The first, the path's abscissa, is the total normal impulse ``sum_j Pn_j`` (N s): the law
+    steps in impulses, and its answer depends on the stiffnesses' ratios only, while the
+    springs' time ``t`` scales with the stiffnesses themselves.
+    """
     history = np.array(impact.history)
     Y, primary = history[:, :-1], history[:, -1].astype(int)
     Pn = impact.I * Y[:, impact.iPn]
@@ -311,6 +316,7 @@ def _path(impact: EnergeticImpact, problem: ImpactProblem) -> dict[str, np.ndarr
     v = problem.v + problem.solve_mass(impulse.T).T
     d = impact.L * np.maximum(Y[:, impact.iS], 0.0)
     return {
+        "Pn_sum": Pn.sum(axis=1),
         "t": impact.tau0 * Y[:, -1],
         "Pn": Pn,
         "Pt": Pt,

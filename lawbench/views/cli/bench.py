@@ -99,6 +99,8 @@ def _bench_problems(args: argparse.Namespace) -> None:
             table.to_csv(handle, index=False)
         from lawbench.views.plotting import plot_profiles
 
-        plot_profiles(performance_profiles(table, tol)).figure.savefig(drawn, dpi=120, format="png")
+        profiles = plot_profiles(performance_profiles(table, tol)).figure
+        # A tight box keeps the legend, drawn right of the axes.
+        profiles.savefig(drawn, dpi=120, format="png", bbox_inches="tight")
     print(problems_summary(table, notes, tol))
     print(f"table written to {out}, performance profiles to {figure}")

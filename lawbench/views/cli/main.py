@@ -16,6 +16,7 @@ import warnings
 from collections.abc import Callable, Sequence
 
 from lawbench.core.errors import (
+    BudgetExceeded,
     InvalidProblem,
     LawbenchError,
     LossyExport,
@@ -317,7 +318,7 @@ def _main(argv: Sequence[str] | None, own_process: bool) -> int:
             if args.verbose or issubclass(warning.category, LossyExport):
                 _say(f"lawbench: warning: {warning.message}")
     except LawbenchError as exc:
-        _say(f"lawbench: {_one_line(exc)}")
+        _say(f"lawbench: {_one_line(exc)}{_spent(exc)}")
         return next(code for kind, code in EXIT_CODES.items() if isinstance(exc, kind))
     except MemoryError:
         return _out_of_memory()
@@ -332,6 +333,16 @@ def _main(argv: Sequence[str] | None, own_process: bool) -> int:
         _say(f"lawbench: internal error: {type(exc).__name__}: {_one_line(exc)}")
         return 1
     return 0
+
+
+def _spent(exc: LawbenchError) -> str:
+    """`` after S s`` for a budget that ran out, whose message leaves the time out.
+
+    The message itself stays deterministic: a run table groups its failed cells by message.
+    """
+    if isinstance(exc, BudgetExceeded) and exc.spent_s is not None:
+        return f" after {exc.spent_s:.3g} s"
+    return ""
 
 
 def _out_of_memory() -> int:

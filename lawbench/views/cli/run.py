@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
+import time
 from pathlib import Path
 
 from lawbench.core.case import CASES
@@ -116,6 +118,7 @@ def run(args: argparse.Namespace) -> None:
     print(f"run: {count} cell{'s' if count != 1 else ''}; {spec.describe()}", flush=True)
     if count > LARGE_GRID and not args.resume:
         _confirm_large(args, spec, count)
+    start = time.perf_counter()
     table, computed = run_grid(
         spec.plan(),
         out,
@@ -132,9 +135,19 @@ def run(args: argparse.Namespace) -> None:
     if args.resume and computed == 0:
         print(f"{out} is complete: {len(table)} rows, nothing left to compute")
         return
-    failed = int((table["error_class"].fillna("") != "").sum()) if len(table) else 0
+    errors = list(table["error_class"].fillna("")) if len(table) else []
+    # A law that does not apply to a cell refused it; any other error is a failure.
+    refused = errors.count("NotApplicable")
+    failed = len(errors) - errors.count("") - refused
     rows = f"{len(table)} row{'s' if len(table) != 1 else ''}"
-    print(f"{rows} in {out} ({computed} computed now, {failed} failed)")
+    print(
+        f"{rows} in {out} ({computed} computed now, {refused} refused, {failed} failed)",
+        flush=True,
+    )
+    # The time on stderr: the table and the lines above are the same in every run.
+    seconds = time.perf_counter() - start
+    rate = f", {computed / seconds:.3g} rows/s" if seconds > 0 else ""
+    print(f"run: {computed} rows computed in {seconds:.3g} s{rate}", file=sys.stderr)
 
 
 def _confirm_large(args: argparse.Namespace, spec: object, count: int) -> None:

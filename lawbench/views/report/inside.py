@@ -4,7 +4,9 @@ A view of the studies the laws declare with `lawbench.studies.declared.impact_pa
 resolve the impact along an impact variable return, with the option ``path``, what happens on the
 way (`lawbench.core.outcome.Outcome.path`). Each quantity is drawn against the path's first entry
 (the impact variable: time, normal impulse, or Jia's parameter), one panel per quantity and unit,
-one line per component, labelled with its name and unit; phases a law reports at normal impulses
+one line per component (named in the legend below the panels), labelled with its name and
+unit (lzb's impact variable is the total normal impulse, Jia's the impulse-curve parameter, the
+compliant model's the time); phases a law reports at normal impulses
 (stick, slip, end of compression) are marked when the impact variable is the normal impulse.
 
 A study that names path quantities after its grid parameter in ``axes``
@@ -37,6 +39,7 @@ QUANTITIES = {
     "t": ("time", "s"),
     "tau": ("impulse-curve parameter", "N s"),
     "Pn": ("normal impulse", "N s"),
+    "Pn_sum": ("total normal impulse", "N s"),
     "Pt": ("tangential impulse", "N s"),
     "un": ("normal contact velocity", "m/s"),
     "ut": ("tangential contact velocity", "m/s"),
@@ -114,8 +117,6 @@ def _figure(case: Case, what: str, row: dict[str, Any], found: dict[str, Any]) -
             _mark_phases(ax, found["phases"], found["phase_impulses"])
         ax.set(title=title.rsplit(" [", 1)[0], xlabel=f"{x_name} [{x_unit}]", ylabel=title)
         ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 3))
-        if 1 < len(list(chosen)) <= 6:
-            ax.legend(fontsize="xx-small")
     for ax in axes.flat[len(panels) :]:
         ax.set_axis_off()
     setting = row["params"].strip("{}").replace('"', "") or "defaults"
@@ -181,8 +182,6 @@ def _along(case: Case, study: Study, table: pd.DataFrame) -> Figure:
             ax.set(title=heading, xlabel=f"{x_name} [{x_unit}]", ylabel=f"{name} [{key_unit}]")
             ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 3))
             _spread(ax, series)
-            if 1 < series.shape[1] <= 6:
-                ax.legend(fontsize="xx-small")
     fig.suptitle(f"{', '.join(laws)} on {case.name} along {axis}")
     reproduce = "; ".join(f"`{row['reproducer']}`" for row in rows)
     caption = f"{study.title}. Reproduce: {reproduce}."
@@ -230,6 +229,6 @@ def _mark_phases(ax: Any, phases: list[str], impulses: list[float]) -> None:
             (impulse, 1.0),
             xycoords=("data", "axes fraction"),
             rotation=90,
-            fontsize=6,
+            fontsize=7,
             va="top",
         )

@@ -2,7 +2,8 @@
 
 A view of the ``summary`` study: per scene, at its default parameters, each law's post-impact
 velocities, kinetic energy change and its *model error* (distance from the scene's ground
-truth, `lawbench.checks.measures.model_error`), beside the ground truth itself and the scene's
+truth, `lawbench.checks.measures.model_error`), beside the ground truth itself (once: the row of
+its own model at its defaults, when it gives the same, is the truth's) and the scene's
 references (case ``references``) whose condition holds there; the error against a reference
 that describes the law (``Reference.applies``) is given too. Velocities of different units are
 drawn on different axes.
@@ -25,6 +26,9 @@ from lawbench.views.report.summary import failure
 
 ANCHOR, TITLE, VIEWS = "outcomes", "Outcomes side by side", ("summary",)
 LINE_STYLES = ("-", "--", ":", "-.")
+# The ground truth's model at its default options is the truth when it agrees to this share of
+# the largest pre-impact velocity (below the tables' four digits): it is shown once, as the truth.
+SAME = 1e-5
 
 
 def build(ctx: Context) -> Section:
@@ -65,7 +69,10 @@ def _scene(case: Case, records: list[dict[str, Any]]) -> list[Any]:
     references = [(r, v) for r, v in references if _holds(r, params)]
     rows = [_row("before the impact (v-)", problem.v, T_minus, T_minus, scale, coordinates)]
     data = _tidy("before the impact", "v-", coordinates, problem.v)
-    truth = None
+    ground = case.ground_truth
+    truths = (parsed(record.get("truth_velocity")) for record in records)
+    truth = next((v for v in truths if v is not None), None) if ground is not None else None
+    same: list[str] = []
     for record in records:
         law = record["law"]
         v_plus = vector(record["v_plus"])
@@ -73,7 +80,9 @@ def _scene(case: Case, records: list[dict[str, Any]]) -> list[Any]:
             if record["verdict"] != "refused":
                 rows.append({"": law, "note": failure(record)})
             continue
-        truth = truth if truth is not None else parsed(record.get("truth_velocity"))
+        if _is_truth(law, v_plus, ground, truth, scale):
+            same.append(law)  # the ground truth's own model: its row is the truth's
+            continue
         options = json.loads(record["options"])
         errors = [
             f"{ref.name}: {np.abs(v_plus - v).max() / scale:.2g}"
@@ -85,12 +94,12 @@ def _scene(case: Case, records: list[dict[str, Any]]) -> list[Any]:
         row["model error"] = "" if model is None else f"{model:.2g}"
         rows.append({**row, "vs reference": "; ".join(errors), "note": record["formulation"]})
         data = pd.concat([data, _tidy(law, "law", coordinates, v_plus)])
-    ground = case.ground_truth
-    if truth is not None and ground is not None:
+    if truth is not None:
         label = f"ground truth: {ground.describe()}"
         v = np.asarray(truth, dtype=float)
         row = _row(label, v, kinetic_energy(problem.M, v), T_minus, scale, coordinates)
-        rows.append({**row, "note": ground.why})
+        at_defaults = f" (`{same[0]}` at its default options gives the same)" if same else ""
+        rows.append({**row, "note": ground.why + at_defaults})
         data = pd.concat([data, _tidy(label, "reference", coordinates, v)])
     for ref, v in references:
         label = f"reference {ref.name} ({ref.law})"
@@ -113,6 +122,13 @@ def _scene(case: Case, records: list[dict[str, Any]]) -> list[Any]:
             data.reset_index(drop=True),
         ),
     ]
+
+
+def _is_truth(law: str, v_plus: np.ndarray, ground: Any, truth: Any, scale: float) -> bool:
+    """Whether ``law``'s answer is the ground truth's: its model, the same to the table's digits."""
+    if truth is None or law != ground.law:
+        return False
+    return bool(np.abs(v_plus - np.asarray(truth, dtype=float)).max() <= SAME * scale)
 
 
 def _row(label: str, v: np.ndarray, T: float, T_minus: float, scale: float, names: list) -> dict:
@@ -157,9 +173,4 @@ def _figure(data: pd.DataFrame, coordinates: list[str], case: str) -> Any:
         ax.set_xticks(x, names, rotation=30 if len(names) > 3 else 0)
         ax.set_ylabel(f"velocity [{unit or 'as named'}]")
     axes[0, 0].set_title(case)
-    # Below the panels, so the legend never narrows them.
-    handles, labels = axes[0, -1].get_legend_handles_labels()
-    fig.legend(
-        handles, labels, fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=4
-    )
-    return fig
+    return fig  # its legend, every law and reference, goes below the panels when drawn

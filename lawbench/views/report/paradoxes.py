@@ -5,6 +5,10 @@ names the two parameters its map spans (and the example it starts from). Every l
 treat the scene is solved on the grid; its relative energy change ``dT / T-`` is mapped, and
 beside it the verdict of each cell (the energy-gain check: a gain the law's findings predict is
 a *law property*, any other gain is not). A table gives, per law, where it gains energy.
+
+Two laws a row (each law's map and its verdicts side by side) keep a figure as wide as the page,
+its labels readable; the colour scale is the scene's own, symmetric and logarithmic beyond
+``LINEAR``, so that one law's gain of 8 does not wash out another's change of 1e-2.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from matplotlib.colors import ListedColormap, TwoSlopeNorm
+from matplotlib.colors import ListedColormap, SymLogNorm
 
 from lawbench.checks.outcome_checks import TOLERANCE
 from lawbench.core.case import Case
@@ -28,6 +32,10 @@ from lawbench.views.report.summary import failure
 
 ANCHOR, TITLE, VIEWS = "paradoxes", "Energy-increase paradoxes", ("paradoxes",)
 CLASSES = list(Verdict)
+# Two laws per row of panels (each law's map and its verdicts): the figure fits the page.
+LAWS_PER_ROW = 2
+# |dT / T-| below this is drawn on a linear colour scale, above on a logarithmic one.
+LINEAR = 1e-3
 
 
 def axis_label(case: Case, name: str) -> str:
@@ -117,38 +125,53 @@ def _regions(case: str, data: pd.DataFrame, x: str, y: str) -> list[dict]:
     return rows
 
 
+def _norm(values: np.ndarray) -> SymLogNorm:
+    """A colour scale symmetric about 0 and logarithmic beyond `LINEAR` of ``dT / T-``.
+
+    A gain of 8 and a loss of 0.01 on one map both stay visible; the scale is the map's own.
+    """
+    finite = np.abs(values[np.isfinite(values)])
+    bound = max(float(finite.max()) if finite.size else 1.0, 10 * LINEAR)
+    return SymLogNorm(linthresh=LINEAR, vmin=-bound, vmax=bound, base=10)
+
+
 def _figure(case: Case, study: Study, data: pd.DataFrame) -> Figure:
     x, y = study.axes
     laws = list(dict.fromkeys(data["law"]))
-    fig, axes = plots.figure(2, len(laws), width=3.4, height=3.0)
-    values = data["dT_over_T"].to_numpy(dtype=float)
-    finite = values[np.isfinite(values)]
-    low = min(float(finite.min()) if finite.size else -1.0, -1e-12)
-    high = max(float(finite.max()) if finite.size else 1.0, 1e-12)
-    norm = TwoSlopeNorm(vcenter=0.0, vmin=low, vmax=high)
+    rows = -(-len(laws) // LAWS_PER_ROW)
+    fig, axes = plots.figure(rows, 2 * min(len(laws), LAWS_PER_ROW), width=2.9, height=2.7)
+    norm = _norm(data["dT_over_T"].to_numpy(dtype=float))
     classes = ListedColormap([COLOURS[v] for v in CLASSES])
     for k, law in enumerate(laws):
         part = data[data["law"] == law]
         grid = part.pivot_table(index=y, columns=x, values="dT_over_T", aggfunc="first")
-        top, bottom = axes[0, k], axes[1, k]
-        mesh = top.pcolormesh(grid.columns, grid.index, grid.to_numpy(), norm=norm, cmap="RdBu_r")
+        row, col = divmod(k, LAWS_PER_ROW)
+        change, verdict = axes[row, 2 * col], axes[row, 2 * col + 1]
+        mesh = change.pcolormesh(
+            grid.columns, grid.index, grid.to_numpy(), norm=norm, cmap="RdBu_r"
+        )
+        fig.colorbar(mesh, ax=change, label="dT / T- [-]")
         codes = part.assign(code=[CLASSES.index(Verdict(v)) for v in part["verdict"]])
         kinds = codes.pivot_table(index=y, columns=x, values="code", aggfunc="first")
-        bottom.pcolormesh(
+        verdict.pcolormesh(
             kinds.columns, kinds.index, kinds.to_numpy(), cmap=classes, vmin=-0.5, vmax=5.5
         )
-        top.set(title=f"{law}: dT / T-")
-        bottom.set(title=f"{law}: verdict")
-        for ax in (top, bottom):
+        change.set(title=f"{law}: dT / T-")
+        verdict.set(title=f"{law}: verdict")
+        for ax in (change, verdict):
             ax.set(xlabel=axis_label(case, x), ylabel=axis_label(case, y))
-    fig.colorbar(mesh, ax=axes[0, -1], label="dT / T- (dimensionless)")
+    for ax in axes.flat[2 * len(laws) :]:
+        ax.set_axis_off()
     fixed = label(dict(study.params), skip=())
     return Figure(
         f"paradoxes_{case.name}",
-        f"Energy change dT / T- (top, red: energy created) and verdict (bottom, colours of "
-        f"the legend) of every law on `{case.name}` over {x} and {y}"
+        f"Energy change dT / T- (red: energy created; a colour scale of this scene's own, "
+        f"linear within {LINEAR:g} of zero and logarithmic beyond, so small and large changes "
+        f"both show) and verdict (colours of the legend) of every law on `{case.name}` over "
+        f"{x} and {y}"
         + (f", with {fixed}" if fixed else "")
-        + ", the other parameters at their defaults.",
+        + "; a blank cell: the law gave no answer there. The other parameters at their "
+        "defaults.",
         fig,
         data,
     )

@@ -7,9 +7,10 @@ measure (a vector measure gives one panel per component); the table lists every 
 verdict. An abscissa over two decades or more (a stiffness ratio) is drawn on a log scale.
 The abscissa takes the unit of the scene's parameter, each panel the unit the study
 declares for its measure (``Study.units``): one panel holds one quantity, so quantities of
-different units (m/s, rad/s) never share an axis. A study declared with the shape ``table_path``
-draws each law's path of a ball on the table (its ``table_path`` measure, x and y in m) in one
-panel per value of its parameter.
+different units (m/s, rad/s) never share an axis; a cell without a value (a path that does not
+curve) is a gap in its line, never a zero. The laws' legend is below the panels. A study
+declared with the shape ``table_path`` draws each law's path of a ball on the table (its
+``table_path`` measure, x and y in m) in one panel per value of its parameter.
 """
 
 from __future__ import annotations
@@ -82,7 +83,6 @@ def _paths(name: str, title: str, table: pd.DataFrame, axis: str) -> Figure:
     for ax, value in zip(axes[0], values, strict=False):
         ax.set(title=f"{axis} = {value:g}", xlabel="x [m]", ylabel="y [m]")
         ax.set_aspect("equal", adjustable="datalim")
-        ax.legend(fontsize="x-small")
     caption = (
         f"{title}. Each law's post-impact velocity and spin give the path in closed form: a "
         "hop (landing marked by a cross), sliding on a parabola, rolling from the dot on."
@@ -194,8 +194,9 @@ def _figure(
             if law not in same:
                 continue
             ordered = group.sort_values(axis)
-            # Rounding noise of a quantity that is zero (1e-15 beside a component of 4) is 0.
-            shown = ordered[column].where(ordered[column].abs() > floors[column], 0.0)
+            # Rounding noise of a quantity that is zero (1e-15 beside a component of 4) is 0;
+            # a cell without the measure (NaN) stays NaN, a gap in its line.
+            shown = ordered[column].mask(ordered[column].abs() <= floors[column], 0.0)
             base, _, values = str(law).partition(" (")
             style = {**plots.law_style(base), "label": " = ".join(same[law])}
             style["linestyle"] = DASHES[variants.index(values) % len(DASHES)]
@@ -205,7 +206,6 @@ def _figure(
         ax.set_xlabel(unit_label(axis, units))
         ax.set_ylabel(unit_label(column, units))
         ax.set_title(column)
-        ax.legend(fontsize="small")
     for ax in list(axes.flat)[len(columns) :]:
         ax.set_visible(False)
     data = frame.replace({np.nan: None})
