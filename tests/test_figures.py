@@ -222,14 +222,23 @@ def test_no_caption_of_the_figures_says_nan(sections):
         assert not re.search(r"\bnan\b", text, re.I), text
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="tradeoff.py writes the accuracy knob of a law without one as '(=nan)' in its note",
-)
 def test_no_speed_accuracy_note_says_nan():
     rows = [
-        {"law": "compliant", "knob": "tol", "value": 1e-6, "failure": "", "wall_time_s": 0.1},
-        {"law": "whittaker", "knob": "", "value": None, "failure": "NotApplicable: 2 contacts"},
+        {
+            "law": "compliant",
+            "knob": "tol",
+            "value": 1e-6,
+            "failure": "",
+            "wall_time_s": 0.1,
+            "verdict": "holds",
+        },
+        {
+            "law": "whittaker",
+            "knob": "",
+            "value": None,
+            "failure": "NotApplicable: 2 contacts",
+            "verdict": "refused",
+        },
     ]
     data = pd.DataFrame(rows).assign(candidate=True, model_error=np.nan, numerical_error=np.nan)
     blocks = tradeoff._scene_blocks(CASES.get("billiard"), data, 1)

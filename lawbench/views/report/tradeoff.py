@@ -143,7 +143,6 @@ def _scene_blocks(case: Case, data: pd.DataFrame, repeats: int) -> list[Any]:
         ax.step(shown["wall_time_s"], floored, "k--", where="post", linewidth=0.8)
         ax.plot(shown["wall_time_s"], floored, "ko", fillstyle="none", markersize=11)
         ax.plot([], [], "ko", fillstyle="none", label="Pareto front")
-    axes[0, 0].legend(fontsize="x-small")
     fig.suptitle(case.name)
     truth = case.ground_truth
     named = f"{truth.describe()}: {truth.why}" if truth else "none declared"
@@ -158,7 +157,12 @@ def _scene_blocks(case: Case, data: pd.DataFrame, repeats: int) -> list[Any]:
     )
     failed = data[data["failure"] != ""]
     notes = dict.fromkeys(
-        f"`{r.law}` ({r.knob}={r.value}) gave no answer on `{case.name}`: {r.failure}."
+        f"`{r.law}`{_setting(r.knob, r.value)} gave no answer on `{case.name}`: {r.failure}."
         for r in failed.itertuples()
     )
     return [Figure(f"tradeoff_{case.name}", caption, fig, data), *notes]
+
+
+def _setting(knob: str, value: object) -> str:
+    """`` (tol=1e-06)`` for a law's accuracy knob at a value; nothing for a law without one."""
+    return f" ({knob}={value})" if knob and not pd.isna(value) else ""
