@@ -274,12 +274,14 @@ def test_the_page_renders_in_chromium_with_its_answer_first_and_readable_headers
     assert _attribute(dom, "split") == "", "header cells broken inside a word"
     assert int(_attribute(dom, "width")) <= 1280
     assert _attribute(dom, "wide") == ""
-    small = []
+    rendered = {}
     for shown in _attribute(dom, "shown").split():
         name, width = shown.rsplit(":", 1)
         points, whole = tick_points(report / f"{name}.svg")
-        if points is not None and points * float(width) / whole < 9:
-            small.append(f"{name}: {points * float(width) / whole:.1f} px")
+        if points is not None:
+            rendered[name] = points * float(width) / whole
+    assert rendered, "no tick label found in the page's figures"
+    small = {name: f"{px:.1f} px" for name, px in rendered.items() if px < 9}
     assert not small, f"tick labels under 9 px tall: {small}"
     shot = tmp_path / "page.png"
     subprocess.run(
