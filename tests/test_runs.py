@@ -205,6 +205,28 @@ def test_the_guard_returns_answers_and_errors_and_stops_a_task_over_its_budget()
         assert guard.result(fine).value == 2.0
 
 
+def _loaded_slowly(seconds: float) -> float:
+    time.sleep(seconds)
+    return seconds
+
+
+class SlowToLoad:
+    """An argument whose unpickling in the worker takes ``seconds`` (an import, say)."""
+
+    def __init__(self, seconds: float) -> None:
+        self.seconds = seconds
+
+    def __reduce__(self):
+        return _loaded_slowly, (self.seconds,)
+
+
+def test_a_task_is_timed_from_when_its_worker_begins_it():
+    """A worker's start-up and the imports its task needs are not the task's seconds."""
+    with Guard(workers=1, budget_s=30.0) as guard:
+        result = guard.result(guard.submit(abs, SlowToLoad(3.0), budget=1.0))
+    assert (result.status, result.value) == ("ok", 3.0)
+
+
 @pytest.mark.parametrize("executor", ["serial", "processes"])
 def test_a_cell_stopped_by_the_guard_is_a_budget_cell_naming_it(tmp_path, executor):
     plan = Plan("slow", [SLOW, Job("newton", "ball_chain")])

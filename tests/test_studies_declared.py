@@ -7,8 +7,9 @@ import pytest
 
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.law import LAWS
 from lawbench.studies.declared import SHAPES, STUDIES, _Studies, build
-from lawbench.studies.study import Study
+from lawbench.studies.study import Study, costly, evenly
 from lawbench.views.report.config import VIEWS, view
 
 LOAD_EVERY_SCENE_AND_LAW = """
@@ -86,3 +87,43 @@ def test_a_bad_declaration_stops_the_registry_when_it_is_first_asked(monkeypatch
 def test_every_shape_builds_a_study_the_report_draws():
     drawn = {"grazing", "duplicated_contact", "large_friction"}  # axes of the stability grid
     assert set(SHAPES) - drawn <= set(VIEWS)
+
+
+def _values(jobs, law):
+    """The parameter grid, options and transforms ``law``'s cells of ``jobs`` take."""
+    cells = [job for job in jobs if job.law == law]
+    return (
+        {(tuple(map(str, job.params.values()))) for job in cells},
+        {tuple(job.options.items()) for job in cells},
+        {job.transform for job in cells},
+    )
+
+
+@pytest.mark.parametrize("name", ["three_ball_chain_grazing", "three_ball_chain_speed_accuracy"])
+def test_the_quick_report_gives_the_laws_that_follow_time_a_subsample(name):
+    """Engines and compliant laws get each axis's first value; the others, and the full
+    report, every value; the study as declared (``lawbench study``) is left whole."""
+    declared = STUDIES.get(name)
+    quick, full = declared.preset("quick"), declared.preset("full")
+    assert full.costly_points is None and declared.costly_points is None
+    assert quick.costly_points == 1
+    whole, thinned = list(declared.jobs()), list(quick.jobs())
+    laws = {job.law for job in whole}
+    costly_laws = {law for law in laws if costly(LAWS.get(law))}
+    assert {"mujoco", "compliant", "lzb"} <= costly_laws and "newton" in laws - costly_laws
+    for law in laws:
+        kept, every = _values(thinned, law), _values(whole, law)
+        if law not in costly_laws:
+            assert kept == every, law
+            continue
+        assert all(len(k) == 1 for k in kept), (law, kept)
+        assert all(k <= e for k, e in zip(kept, every, strict=True)), law
+        first = next(job for job in whole if job.law == law)
+        assert next(job for job in thinned if job.law == law) == first
+    assert len(list(full.jobs())) > len(whole) > len(thinned)
+
+
+def test_evenly_spaced_values_keep_the_ends_and_one_is_the_first():
+    assert evenly([1, 2, 3, 4, 5], 3) == [1, 3, 5]
+    assert evenly([1, 2, 3], 1) == [1]
+    assert evenly([1, 2], 5) == [1, 2] and evenly([1, 2], None) == [1, 2]

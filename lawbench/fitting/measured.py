@@ -52,6 +52,7 @@ from lawbench.fitting.coefficients import Free, start_point
 from lawbench.fitting.model import least_squares
 from lawbench.fitting.uncertainty import FLAT_TOL, summarize
 from lawbench.measurements import MEASUREMENTS, MeasuredImpact, MeasurementSet
+from lawbench.studies.study import evenly
 
 # The accuracy knob of every law that has one, and the wall-clock budget of one solve.
 TOL = 1e-6
@@ -250,13 +251,6 @@ def study_options(law: Law) -> dict[str, Any]:
     names = {spec.name for spec in law.options}
     given = {"tol": TOL} if "tol" in names else {}
     return law.option_values({**given, "max_seconds": MAX_SECONDS})
-
-
-def evenly(items: Sequence[Any], count: int | None) -> list[Any]:
-    """``count`` of ``items`` at evenly spaced positions (all of them when fewer or None)."""
-    if count is None or count >= len(items):
-        return list(items)
-    return [items[k] for k in np.linspace(0, len(items) - 1, count).round().astype(int)]
 
 
 def measured_study(

@@ -34,6 +34,15 @@ from lawbench.studies.study import Measure, Study
 
 # Accuracy knob values of the speed/accuracy sweep (quick; the full report sweeps every decade).
 KNOBS = (1e-2, 1e-6, 1e-10)
+# Values of each swept axis a law that follows the impact through time (an engine, or a law that
+# integrates the compliant impact: `lawbench.studies.study.costly`) is given in the quick report's
+# speed/accuracy and stability studies (`lawbench.studies.study.evenly`: one is an axis's first
+# value, its mildest knob); the full report gives it every value. Two would keep each axis's
+# last value, the extreme where such a law runs until the quick report's wall-clock guard stops
+# it (a step of 1e-10 s, a grazing speed of 1e-12 m/s, mu = 1000): a third or more of the quick
+# report's time for cells whose answer is that they are out of budget.
+QUICK_COSTLY_POINTS = 1
+QUICK_COSTLY = {"costly_points": QUICK_COSTLY_POINTS}
 # Perturbation sizes of the continuity sweep (quick and full).
 JUMP_SIZES = (1e-2, 1e-4, 1e-6)
 FULL_JUMP_SIZES = tuple(10.0**-k for k in range(1, 9))
@@ -58,6 +67,7 @@ def speed_accuracy(case: str, slow: bool = False) -> Study:
         shape="speed_accuracy",
         slow=slow,
         full={"knobs": decades(-1, -11, -1), "repeats": 5},
+        quick=QUICK_COSTLY,
     )
 
 
@@ -94,6 +104,7 @@ def extremes(
         axes=(axis,),
         shape="extremes",
         full=dict(full or {}),
+        quick=QUICK_COSTLY,
         slow=slow,
     )
 

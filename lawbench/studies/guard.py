@@ -35,6 +35,12 @@ if TYPE_CHECKING:
 
 TIME_OUT = "time-out"
 WARNINGS_KEPT = 10
+# Seconds a worker may take to receive a task (start up, import what the task's function and
+# arguments need) before the task's own budget starts: a task is timed from when it begins, so
+# that a loaded machine's slow imports stop no task, and a worker stuck importing still ends.
+STARTUP_S = 120.0
+# What a worker sends when it begins a task, before its result.
+_BEGUN = "begun"
 # Seconds a cell may run before the guard stops it, unless told otherwise.
 BUDGET_S = 600.0
 # Where guarded cells run (`lawbench.studies.runner.Executor`): this process, local workers, Dask.
@@ -99,6 +105,7 @@ def _serve(connection: Connection) -> None:
         if message is None:
             return
         number, function, args = message
+        connection.send((_BEGUN, number))
         start = time.perf_counter()
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -227,7 +234,7 @@ class Guard:
             if worker.task is None and self._queue:
                 task = self._queue.popleft()
                 worker.task, worker.budget = task.number, task.budget
-                worker.deadline = time.monotonic() + task.budget
+                worker.deadline = time.monotonic() + STARTUP_S + task.budget
                 worker.connection.send((task.number, task.function, task.args))
         busy = [w for w in self._pool if w.task is not None]
         if not busy:
@@ -242,11 +249,15 @@ class Guard:
 
     def _receive(self, worker: _Worker) -> None:
         try:
-            number, value, error_class, message, caught, seconds = worker.connection.recv()
+            reply = worker.connection.recv()
         except (EOFError, OSError):
             code = worker.process.exitcode
             self._replace(worker, Result("error", None, "WorkerDied", f"exit code {code}"))
             return
+        if reply[0] == _BEGUN:
+            worker.deadline = time.monotonic() + worker.budget
+            return
+        number, value, error_class, message, caught, seconds = reply
         status = "error" if error_class else "ok"
         self._results[number] = Result(status, value, error_class, message, caught, seconds)
         worker.task = None

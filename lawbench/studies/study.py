@@ -43,6 +43,8 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from lawbench.checks.knobs import knob_values
 from lawbench.core.errors import InvalidProblem
 
@@ -56,6 +58,25 @@ Measure = Callable[[Any], Any]
 # requirements ('covering'), every law that accepts the problem built at the study's fixed
 # parameters ('able'), or every registered law, refusals included ('every').
 LAW_CHOICES = ("covering", "able", "every")
+
+
+def evenly(items: Sequence[Any], count: int | None) -> list[Any]:
+    """``count`` of ``items`` at evenly spaced positions (all of them when fewer or None).
+
+    The first and the last are among two or more; one is the first.
+    """
+    if count is None or count >= len(items):
+        return list(items)
+    return [items[k] for k in np.linspace(0, len(items) - 1, count).round().astype(int)]
+
+
+def costly(law: Law) -> bool:
+    """Whether ``law`` follows the impact through time (its cells cost the most).
+
+    An engine stepping the scene, or a law that reads the contacts' stiffness and integrates
+    the compliant impact.
+    """
+    return law.engine or law.tags.stiffness
 
 
 def _cli(value: Any) -> str:
@@ -196,6 +217,12 @@ class Study:
         Left out of the quick report (a long sweep).
     full : mapping
         Field replacements in the full report (larger grids).
+    quick : mapping
+        Field replacements in the quick report (``costly_points``).
+    costly_points : int or None
+        The points of each swept axis (a grid parameter, the transform's values, the accuracy
+        knob's values) that a law following the impact through time (`costly`) is given,
+        evenly spaced (`evenly`); None gives it every point.
     """
 
     name: str
@@ -217,6 +244,8 @@ class Study:
     shape: str | None = None
     slow: bool = False
     full: Mapping[str, Any] = field(default_factory=dict)
+    quick: Mapping[str, Any] = field(default_factory=dict)
+    costly_points: int | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.laws, str) and self.laws not in LAW_CHOICES:
@@ -243,7 +272,7 @@ class Study:
 
     def preset(self, mode: str) -> Study:
         """The study as the report's ``mode`` ('quick' or 'full') runs it."""
-        return dataclasses.replace(self, **self.full) if mode == "full" else self
+        return dataclasses.replace(self, **(self.full if mode == "full" else self.quick))
 
     def with_params(self, given: Mapping[str, Any]) -> Study:
         """The study with parameters fixed (a grid parameter given is no longer swept)."""
@@ -256,7 +285,8 @@ class Study:
         """Every cell, those of ``laws`` on ``cases`` when given.
 
         Scenes outermost, then laws, the parameter grid, the option grid, the transform values
-        and the repeats.
+        and the repeats. A law that follows the impact through time is given ``costly_points``
+        points of each of them when that is set.
 
         Raises
         ------
@@ -267,7 +297,6 @@ class Study:
         from lawbench.core.law import LAWS
         from lawbench.core.transforms import spell
 
-        transforms = [spell(self.transform, v) for v in self.transform_values] or [""]
         for case_name in self.case_names():
             if cases is not None and case_name not in cases:
                 continue
@@ -275,15 +304,21 @@ class Study:
             for law_name in self.law_names(case):
                 if laws is not None and law_name not in laws:
                     continue
+                law = LAWS.get(law_name)
+                count = self.costly_points if costly(law) else None
                 option_grid = {k: list(v) for k, v in self.options.get(law_name, {}).items()}
                 if self.knobs:
-                    knob, values = knob_values(LAWS.get(law_name), self.knobs)
+                    knob, values = knob_values(law, self.knobs)
                     if knob is not None:
                         option_grid[knob] = values
-                for params in _product(self.grid):
+                option_grid = {k: evenly(v, count) for k, v in option_grid.items()}
+                grid = {k: evenly(v, count) for k, v in self.grid.items()}
+                values = evenly(self.transform_values, count)
+                transforms = [spell(self.transform, v) for v in values] or [""]
+                for params in _product(grid):
                     params = {**self.params, **params}
                     for options in _product(option_grid):
-                        self._check(case, LAWS.get(law_name), params, options)
+                        self._check(case, law, params, options)
                         for transform in transforms:
                             for repeat in range(self.repeats):
                                 yield Job(law_name, case_name, params, options, transform, repeat)

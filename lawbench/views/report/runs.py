@@ -8,6 +8,7 @@ the full mode resumes an interrupted report. A section is a view of study tables
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 from collections.abc import Sequence
@@ -83,6 +84,37 @@ def label(params: dict[str, Any], skip: Sequence[str]) -> str:
     return ", ".join(shown)
 
 
+def _left_to_full(study: Study, cells: int, laws: list[str], cases: list[str]) -> int:
+    """How many cells ``study``, planned with ``cells``, leaves to the full report."""
+    if study.costly_points is None:
+        return 0
+    whole = dataclasses.replace(study, costly_points=None)
+    return len(whole.plan(laws, cases).jobs) - cells
+
+
+def _thinning(left: dict[str, tuple[int, int | None]]) -> list[str]:
+    """Notes on the studies whose costly laws ran a subsample: study -> (cells left, points)."""
+    by_points: dict[int | None, list[str]] = {}
+    for name, (cells, points) in left.items():
+        if cells:
+            by_points.setdefault(points, []).append(name)
+    return [
+        "the engines and the laws that integrate the impact in time are given "
+        f"{_values(points)} of each swept axis (parameter, transform, accuracy knob) in "
+        f"{', '.join(f'`{name}`' for name in names)}: "
+        f"{sum(left[name][0] for name in names)} cells are left to the full report "
+        "(`lawbench report --full`)"
+        for points, names in by_points.items()
+    ]
+
+
+def _values(points: int | None) -> str:
+    """Which values of an axis `lawbench.studies.study.evenly` keeps, in words."""
+    if points == 1:
+        return "the first value"
+    return f"{points} evenly spaced values (the first and the last among them)"
+
+
 class Context:
     """What the sections share: the configuration, the output folder, the study tables."""
 
@@ -114,7 +146,7 @@ class Context:
         config, full = self.config, self.config.mode == "full"
         laws = [law.name for law in self.laws]
         cases = [case.name for case in self.cases]
-        plans = []
+        plans, thinned = [], {}
         for study in STUDIES.values():
             if view(study) not in views:
                 self.left_out[study.name] = f"no section draws it (`lawbench study {study.name}`)"
@@ -132,8 +164,11 @@ class Context:
             if plan.jobs:
                 self.studies.append(study)
                 plans.append((plan, self.out / "runs" / f"{study.name}.parquet"))
+                left = _left_to_full(study, len(plan.jobs), laws, cases)
+                thinned[study.name] = (left, study.costly_points)
             else:
                 self.left_out[study.name] = "none of its laws and scenes is selected"
+        self.notes += _thinning(thinned)
         if not full:
             shutil.rmtree(self.out / "runs", ignore_errors=True)
         executor = Executor(
