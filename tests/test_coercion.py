@@ -70,5 +70,7 @@ def test_a_bad_item_of_a_list_is_named_by_its_index(value, message):
 
 def test_a_build_error_names_only_the_parameters_that_differ_from_the_defaults():
     case = lawbench.CASES["billiard"]
-    with pytest.raises(InvalidProblem, match=r"^billiard: radius = 1e-308: "):
-        case.build_from(case.parameters(radius=1e-308))
+    straight = {"offset_side": 0.0, "offset_height": 0.0}
+    given = r"radius = 1e-308, offset_side = 0.0, offset_height = 0.0"
+    with pytest.raises(InvalidProblem, match=rf"^billiard: {given}: "):
+        case.build_from(case.parameters(radius=1e-308, **straight))

@@ -221,6 +221,7 @@ def test_a_law_never_returns_a_non_finite_answer(field, value):
 
 
 def test_a_scene_whose_formulas_leave_double_precision_names_what_was_given():
-    """radius = 1e-308 gives the billiard's Jacobian a 0/0: the message names the radius."""
-    with pytest.raises(InvalidProblem, match=r"billiard: radius = 1e-308: Wt\[0, 0\] is not a"):
-        lawbench.CASES["billiard"].build(radius=1e-308)
+    """radius = 1e-308 gives a straight shot's Jacobian a 0/0: the message names the radius."""
+    given = r"radius = 1e-308, offset_side = 0.0, offset_height = 0.0"
+    with pytest.raises(InvalidProblem, match=rf"billiard: {given}: Wt\[0, 0\] is not a"):
+        lawbench.CASES["billiard"].build(radius=1e-308, offset_side=0.0, offset_height=0.0)

@@ -37,10 +37,10 @@ KNOBS = (1e-2, 1e-6, 1e-10)
 # Values of each swept axis a law that follows the impact through time (an engine, or a law that
 # integrates the compliant impact: `lawbench.studies.study.costly`) is given in the quick report's
 # speed/accuracy and stability studies (`lawbench.studies.study.evenly`: one is an axis's first
-# value, its mildest knob); the full report gives it every value. Two would keep each axis's
-# last value, the extreme where such a law runs until the quick report's wall-clock guard stops
-# it (a step of 1e-10 s, a grazing speed of 1e-12 m/s, mu = 1000): a third or more of the quick
-# report's time for cells whose answer is that they are out of budget.
+# value), with its accuracy knob at its default; the full report gives it every value. Two would
+# keep each axis's last value, the extreme where such a law runs until the quick report's
+# wall-clock guard stops it (a step of 1e-10 s, a grazing speed of 1e-12 m/s, mu = 1000): a third
+# or more of the quick report's time for cells whose answer is that they are out of budget.
 QUICK_COSTLY_POINTS = 1
 QUICK_COSTLY = {"costly_points": QUICK_COSTLY_POINTS}
 # Perturbation sizes of the continuity sweep (quick and full).

@@ -220,9 +220,10 @@ class Study:
     quick : mapping
         Field replacements in the quick report (``costly_points``).
     costly_points : int or None
-        The points of each swept axis (a grid parameter, the transform's values, the accuracy
-        knob's values) that a law following the impact through time (`costly`) is given,
-        evenly spaced (`evenly`); None gives it every point.
+        The points of each swept axis (a grid parameter, an option, the transform's values)
+        that a law following the impact through time (`costly`) is given, evenly spaced
+        (`evenly`), its accuracy knob at its default, the setting a user gets; None gives it
+        every point and every knob value.
     """
 
     name: str
@@ -286,7 +287,7 @@ class Study:
 
         Scenes outermost, then laws, the parameter grid, the option grid, the transform values
         and the repeats. A law that follows the impact through time is given ``costly_points``
-        points of each of them when that is set.
+        points of each of them when that is set, and its accuracy knob at its default.
 
         Raises
         ------
@@ -310,7 +311,7 @@ class Study:
                 if self.knobs:
                     knob, values = knob_values(law, self.knobs)
                     if knob is not None:
-                        option_grid[knob] = values
+                        option_grid[knob] = values if count is None else [law.option_values()[knob]]
                 option_grid = {k: evenly(v, count) for k, v in option_grid.items()}
                 grid = {k: evenly(v, count) for k, v in self.grid.items()}
                 values = evenly(self.transform_values, count)

@@ -4,7 +4,8 @@ The report knows no scene or law by name: it runs every registered study that a 
 the section chosen here from what the study is (its shape, `Study.shape`: `VIEWS`), sized for
 the mode: ``quick`` (the default: each study as declared with its
 ``quick`` replacements, where the engines and the laws that integrate the impact in time take
-the first value of each swept axis of the speed/accuracy and stability studies; slow ones left
+the first value of each swept axis of the speed/accuracy and stability studies, their accuracy
+knob at its default; slow ones left
 out; a few minutes on two cores) or ``full`` (each study's ``full`` sizes, slow ones in,
 resumable from ``OUT/runs``, on local processes or a Dask cluster). A test may shrink a preset
 with `dataclasses.replace`.

@@ -100,7 +100,8 @@ def _thinning(left: dict[str, tuple[int, int | None]]) -> list[str]:
             by_points.setdefault(points, []).append(name)
     return [
         "the engines and the laws that integrate the impact in time are given "
-        f"{_values(points)} of each swept axis (parameter, transform, accuracy knob) in "
+        f"{_values(points)} of each swept axis (parameter, option, transform) and their "
+        "accuracy knob at its default in "
         f"{', '.join(f'`{name}`' for name in names)}: "
         f"{sum(left[name][0] for name in names)} cells are left to the full report "
         "(`lawbench report --full`)"
