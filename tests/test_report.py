@@ -403,6 +403,23 @@ def test_the_quick_report_end_to_end(quick):
     assert seconds < 300
 
 
+def _answer_without_costs(out: Path) -> pd.DataFrame:
+    """A report's answer table with the costs taken out of its cells ("lzb (tol=1e-10)")."""
+    table = pd.read_csv(out / "answer.csv", keep_default_na=False)
+    return table.replace(r", [\d.]+ [µm]?s$", "", regex=True)
+
+
+@pytest.mark.slow
+def test_two_quick_reports_in_a_row_give_the_same_answer_but_for_the_costs(quick, tmp_path):
+    """Each cost is a median of timed solves and a tie within the noise goes to the loosest
+    tolerance, then the name: a second quick report chooses the same laws."""
+    again = write_report(tmp_path / "again", mode="quick")
+    first = _answer_without_costs(quick[0])
+    assert first.map(lambda text: " ms" in text or text.endswith(" s")).sum().sum() == 0
+    assert (first != "none").any(axis=None)
+    pd.testing.assert_frame_equal(first, _answer_without_costs(again))
+
+
 @pytest.mark.slow
 def test_the_quick_stability_grid_has_no_nan_and_no_time_out(quick):
     tables = runs(quick[0])
