@@ -406,7 +406,7 @@ def test_the_quick_report_end_to_end(quick):
 def _answer_without_costs(out: Path) -> pd.DataFrame:
     """A report's answer table with the costs taken out of its cells ("lzb (tol=1e-10)")."""
     table = pd.read_csv(out / "answer.csv", keep_default_na=False)
-    return table.replace(r", [\d.]+ [µm]?s$", "", regex=True)
+    return table.replace(r", [\d.]+ [um]?s$", "", regex=True)
 
 
 @pytest.mark.slow

@@ -24,6 +24,7 @@ from typing import Any
 
 import pandas as pd
 
+from lawbench.bench.timing import duration
 from lawbench.core.case import Case
 from lawbench.core.trial import solve
 from lawbench.core.verdicts import Verdict
@@ -124,14 +125,6 @@ def point_text(row: pd.Series) -> str:
     value = row["value"]
     shown = f"{value:g}" if isinstance(value, int | float) else str(value)
     return f"{row['law']} ({row['knob']}={shown})"
-
-
-def duration(seconds: float) -> str:
-    """A cost in s, ms, us or ns, three digits."""
-    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6)):
-        if seconds >= scale:
-            return f"{seconds / scale:.3g} {unit}"
-    return f"{seconds / 1e-9:.3g} ns"
 
 
 def choices(data: pd.DataFrame, costs: pd.Series) -> dict[str, str]:
