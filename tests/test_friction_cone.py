@@ -16,6 +16,9 @@ from lawbench.core.verdicts import Verdict, of_error
 
 FRICTIONS = (0.0, 1e-3, 1.0, 1e3)
 CHECKED = ("friction_cone", "energy_gain")
+# Wall-clock bound of one solve here (s): a budget is one of the accepted outcomes, and the
+# laws' own default (60 s) would let one cell hold a test worker for a minute.
+SECONDS = 30.0
 
 
 def friction_names(case):
@@ -36,7 +39,7 @@ CELLS = [
 def test_every_answer_holds_its_cone_and_its_energy_promise(law, case, mu):
     params = {name: mu for name in friction_names(case)}
     try:
-        trial = lawbench.evaluate(law, case, **params)
+        trial = lawbench.evaluate(law, case, {"max_seconds": SECONDS}, **params)
     except lawbench.LawbenchError as error:
         verdict = of_error(error)
         assert verdict in (Verdict.REFUSED, Verdict.BUDGET), f"{verdict}: {error}"
