@@ -142,7 +142,7 @@ def test_no_recommended_cell_is_a_failure_a_budget_or_unexplained(name, request)
 
 @pytest.mark.parametrize("scene", SWEPT)
 def test_the_same_points_retimed_give_the_same_answer(trade, scene):
-    """Two timings of the same cells (each a median after a warm-up) choose the same laws."""
+    """Two timings of the same cells (each the shortest after a warm-up) choose the same laws."""
     case = lawbench.CASES.get(scene)
     points = _points(trade, scene)
     first, second = (answer.retime(case, points) for _ in range(2))
@@ -170,6 +170,9 @@ def test_a_tie_goes_to_the_loosest_tolerance_and_a_failing_cell_is_never_chosen(
     assert answer.choose(points, costs, 1e-6)["law"] == "lzb"
     assert answer.choose(points, costs, 1e-8) is None
     assert answer.closest(points)["value"] == 1e-6
+    holding = points.assign(verdict="holds")
+    assert answer.choose(holding, costs.mul([30, 1, 9, 9]), 1e-2)["value"] == 1e-2
+    assert answer.choose(holding, costs.mul([30, 1, 9, 9]), 1e-6)["value"] == 1e-6
 
 
 # In the browser: measured with the page's folds closed, then everything measured with them open.

@@ -8,17 +8,22 @@ set, the law closest to the measurements (`lawbench.views.report.measured.closes
 
 Only a cell whose verdict is *holds* or *law property* is recommended: a cell whose verdict is a
 numerical failure, a budget or unexplained is set aside, counted and linked to its line in the
-health of the run. A cost is the median of `TIMINGS` timed solves after `WARM_UPS` warm-up solve
-(`retime`): one wall-clock sample per cell made two runs choose differently. Costs within a
-factor `TIE` of the cheapest are a tie, broken without the clock (`choose`): the loosest
-tolerance first (a law without an accuracy knob counts as the loosest), then the law's name.
+health of the run. A cost is the shortest of `TIMINGS` timed solves after `WARM_UPS` warm-up
+solve (`retime`): the load of a shared machine only ever adds time, so the shortest is the
+steadiest estimate, and one wall-clock sample per cell made two runs choose differently.
+
+The choice (`choose`) leans on the clock as little as it can. Of one law's settings of a
+numeric accuracy knob (a tolerance, a time step: the larger, the looser) that reach a level,
+only the loosest competes: a tighter setting does the same work and more, so only timing noise
+could make it look cheaper. Between laws, costs within a factor `TIE` of the cheapest are a
+tie, broken without the clock: the loosest setting first (a law without a knob counts as the
+loosest), then the law's name.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import statistics
 from collections.abc import Sequence
 from typing import Any
 
@@ -59,7 +64,7 @@ def set_aside(data: pd.DataFrame) -> pd.DataFrame:
 
 
 def retime(case: Case, data: pd.DataFrame) -> pd.Series:
-    """The cost of each candidate point within the loosest level: median of repeated solves.
+    """The cost of each candidate point within the loosest level: shortest of repeated solves.
 
     `WARM_UPS` round of solves, then `TIMINGS` timed rounds, each point solved once a round (a
     burst of load on the machine slows every point alike), each time the law's own wall time
@@ -82,26 +87,39 @@ def retime(case: Case, data: pd.DataFrame) -> pd.Series:
             if repeat >= WARM_UPS:
                 samples[index].append(seconds)
     for index, found in samples.items():
-        costs[index] = statistics.median(found)
+        costs[index] = min(found)
     return costs
 
 
 def _looseness(row: pd.Series) -> tuple[float, str, str]:
     """The clock-free order of a tie: loosest tolerance first, then the law's name."""
     value = row["value"]
-    numeric = isinstance(value, int | float) and not isinstance(value, bool) and value == value
-    return (-float(value) if numeric else -float("inf"), row["law"], str(value))
+    return (-float(value) if _numeric(value) else -float("inf"), row["law"], str(value))
+
+
+def _numeric(value: object) -> bool:
+    """Whether a knob's value orders by looseness: a number, not a choice such as an ordering."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and value == value
+
+
+def _loosest_per_law(found: pd.DataFrame) -> pd.DataFrame:
+    """Of each law's points on a numeric knob, only the loosest; every other point as it is."""
+    numeric = found["value"].map(_numeric)
+    keep = found.loc[numeric, "value"].astype(float).groupby(found.loc[numeric, "law"]).idxmax()
+    return found[~numeric | found.index.isin(keep)]
 
 
 def choose(data: pd.DataFrame, costs: pd.Series, level: float) -> pd.Series | None:
     """The recommended point within ``level``: the loosest of those within `TIE` of the cheapest.
 
-    None when no candidate point reaches ``level``.
+    Only each law's loosest numeric setting that reaches ``level`` competes. None when no
+    candidate point reaches ``level``.
     """
     found = candidates(data)
     found = found[(found["model_error"].astype(float) <= level) & costs[found.index].notna()]
     if found.empty:
         return None
+    found = _loosest_per_law(found)
     cost = costs[found.index]
     tied = found[cost <= TIE * cost.min()]
     order = sorted(tied.index, key=lambda i: _looseness(tied.loc[i]))
@@ -163,9 +181,10 @@ def caption(aside: int, levels: Sequence[float] = LEVELS) -> str:
     return (
         f"Per scene, the law closest to its ground truth and the cheapest law whose model "
         f"error {ERROR} (relative to the largest pre-impact speed, as in the speed/accuracy "
-        f"section) is within {shown}. Cost: the median of {TIMINGS} timed solves after "
+        f"section) is within {shown}. Cost: the shortest of {TIMINGS} timed solves after "
         f"{WARM_UPS} warm-up solve, in rounds over the scene's cells (a cell slower than "
-        f"{RETIME_S:g} s in its study: that one solve). Costs within {TIE:g}x of the "
+        f"{RETIME_S:g} s in its study: that one solve). Of one law's tolerances or time steps "
+        "that reach a level, only the loosest competes. Costs within {TIE:g}x of the "
         "cheapest are a tie, broken by the loosest tolerance (a law without a knob first), "
         "then the law's name. Only cells that hold "
         f"(verdict holds or law property) are recommended: {aside} cells were set aside "
