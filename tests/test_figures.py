@@ -2,8 +2,9 @@
 tick labels readable at the page's width and apart, gaps where a value is missing.
 
 The figures are drawn by the report's own sections from small study tables (fast laws on a few
-scenes) and saved as the page saves them; the page shows an SVG at its natural width up to
-`plots.DISPLAY_WIDTH_PX` and scales a wider one down, its text with it.
+scenes) and small measured studies (closed-form laws on two sets), and saved as the page saves
+them; the page shows an SVG at its natural width up to `plots.DISPLAY_WIDTH_PX` and scales a
+wider one down, its text with it.
 """
 
 import dataclasses
@@ -17,7 +18,16 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import SymLogNorm
 
 from lawbench.core.case import CASES
-from lawbench.views.report import QUICK, inside, outcomes, paradoxes, plots, sweeps, tradeoff
+from lawbench.views.report import (
+    QUICK,
+    inside,
+    measured,
+    outcomes,
+    paradoxes,
+    plots,
+    sweeps,
+    tradeoff,
+)
 from lawbench.views.report.page import Figure, Table, save_figure
 from lawbench.views.report.runs import Context
 
@@ -34,25 +44,27 @@ RUNS = (
     ),
     (("lzb",), ("disk_ball",), ("disk_ball_energies",)),
 )
-SECTIONS = (sweeps, paradoxes, tradeoff, inside, outcomes)
+# The laws and sets of the section against measurements, the quick report's subsample of each:
+# Kharaz's impacts (one planar contact) and the cube's tosses (spatial, several contacts) draw
+# its two kinds of scatter plot, and the two frictional laws, in closed form, Kharaz's curves.
+MEASURED = (("whittaker", "brach"), ("kharaz", "cube"))
+SECTIONS = (sweeps, paradoxes, tradeoff, inside, outcomes, measured)
 MIN_PX = 9.0
 SVG_WIDTH = re.compile(r'<svg[^>]*\swidth="([\d.]+)pt"')
 
 
 @pytest.fixture(scope="module")
 def context(tmp_path_factory):
-    """One context holding the tables of every run of `RUNS`."""
+    """One context holding the tables of every run of `RUNS`, judging `MEASURED`'s laws and sets."""
     out = tmp_path_factory.mktemp("figures")
-    merged = None
+    config = dataclasses.replace(QUICK, executor="serial", workers=1, studies=())
+    laws, sets = MEASURED
+    merged = Context(dataclasses.replace(config, laws=laws, cases=(), measurements=sets), out)
+    views = [view for module in SECTIONS for view in module.VIEWS]
     for laws, cases, studies in RUNS:
-        config = dataclasses.replace(
-            QUICK, executor="serial", workers=1, measurements=(), laws=laws, cases=cases
-        )
-        ctx = Context(dataclasses.replace(config, studies=studies), out / studies[0])
-        ctx.run([module.VIEWS[0] for module in SECTIONS] + ["table_path"])
-        if merged is None:
-            merged = ctx
-            continue
+        run = dataclasses.replace(config, measurements=(), laws=laws, cases=cases, studies=studies)
+        ctx = Context(run, out / studies[0])
+        ctx.run(views)
         merged.studies += ctx.studies
         merged.cases += [case for case in ctx.cases if case not in merged.cases]
         merged._tables |= ctx._tables
@@ -118,7 +130,9 @@ def tick_labels(ax) -> list:
 
 def test_every_section_draws_figures(figures):
     names = [block.name for block, _ in figures]
-    for prefix in ("sweep_", "paradoxes_", "tradeoff_", "inside_", "outcomes_"):
+    prefixes = ("sweep_", "paradoxes_", "tradeoff_", "inside_", "outcomes_")
+    measured_kinds = ("measured_kharaz_scatter", "measured_cube_scatter", "kharaz_curves")
+    for prefix in prefixes + measured_kinds:
         assert any(name.startswith(prefix) for name in names), (prefix, names)
 
 
