@@ -336,7 +336,10 @@ def scatter_data(study: MeasuredStudy, chosen_rows: dict, impacts: Sequence[Any]
 
 
 def scatter(study: MeasuredStudy, data: pd.DataFrame) -> Figure:
-    """Predicted against measured, one panel per quantity, the chosen rows overlaid."""
+    """Predicted against measured, one panel per quantity, the chosen rows overlaid.
+
+    Every row is named once in the legend the report figure gathers below the panels.
+    """
     quantities = list(dict.fromkeys(data["quantity"]))
     fig, axes = plots.figure(1, max(len(quantities), 1), width=3.8, height=3.6)
     for ax, quantity in zip(axes[0], quantities, strict=False):
@@ -361,8 +364,6 @@ def scatter(study: MeasuredStudy, data: pd.DataFrame) -> Figure:
         ax.set_xlabel(f"measured {quantity} [{unit}]")
         ax.set_ylabel(f"predicted [{unit}]")
     axes[0, 0].set_title(study.set_name)
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, 0.0))
     caption = (
         f"Set `{study.set_name}`: predicted against measured velocities after each judged test "
         "impact, for the best law, the best rigid law (one that reads no stiffness) and the "
@@ -410,7 +411,10 @@ def closest_per_set(ctx: Context) -> dict[str, str]:
 
 
 def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
-    """Kharaz's curves over the digitized points, the RMS per range and the reversal."""
+    """Kharaz's curves over the digitized points, the RMS per range and the reversal.
+
+    The laws and the points are named in the legend the report figure gathers below the panels.
+    """
     fig, axes = plots.figure(2, 2, width=4.6, height=3.4)
     points = kharaz_curves.measured()
     for ax, quantity in zip(axes.flat, kharaz_curves.QUANTITIES, strict=True):
@@ -421,8 +425,6 @@ def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
         ax.scatter(at, values, color="k", s=14, zorder=3, label="Kharaz et al. 2001")
         ax.set_xlabel("incidence from the normal [deg]")
         ax.set_ylabel(QUANTITY_LABELS[quantity])
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, 0.0))
     where = (
         "at the digitized incidences only (quick)"
         if quick
