@@ -170,7 +170,7 @@ def test_a_ground_truth_and_a_tightest_knob_naming_the_same_options_are_solved_o
 ):
     """Re-solves are kept under the law's complete options: {'tol': 1e-12} and every option
     spelled out at those values are one answer."""
-    from lawbench.checks import measures
+    from lawbench.checks import measures, solved
 
     problem = lawbench.CASES.get("three_ball_chain").build()
     law = lawbench.LAWS.get("compliant")
@@ -179,7 +179,7 @@ def test_a_ground_truth_and_a_tightest_knob_naming_the_same_options_are_solved_o
     monkeypatch.setattr(
         type(law), "resolve", lambda self, *a, **k: calls.append(1) or resolve(self, *a, **k)
     )
-    monkeypatch.setattr(measures, "_SOLVED", {})
+    monkeypatch.setattr(solved, "_SOLVED", {})
     short = measures._solve("compliant", {"tol": 1e-9}, problem)
     spelled = measures._solve("compliant", law.option_values({"tol": 1e-9}), problem)
     assert len(calls) == 1 and np.array_equal(short, spelled)

@@ -493,6 +493,22 @@ def test_an_engine_that_runs_out_of_steps_names_its_budget(engine):
         lawbench.solve(engine, "three_ball_chain", options={"max_steps": 2})
 
 
+def test_an_engine_s_own_converged_answer_is_one_it_reaches_within_its_step_bound():
+    """The numerical error's reference and a sweep's finest step stop at the engines' finest
+    step: at 1e-12 s, the generic tightest value, MuJoCo ran into its step bound and had no
+    reference at all."""
+    from lawbench.checks.knobs import knob_values, tightest
+    from lawbench.checks.measures import numerical_error
+    from lawbench.core.trial import make_trial
+
+    law = lawbench.LAWS.get("mujoco")
+    finest = law.tags.finest_knob
+    assert tightest(law) == {"dt": finest}
+    assert knob_values(law, [1e-2, 1e-4, 1e-6, 1e-12])[1] == [1e-2, 1e-4]
+    trial = make_trial("mujoco", "rocking_block", options={"dt": 1e-4})
+    assert 0.0 < numerical_error(trial) < 1e-2
+
+
 @pytest.mark.parametrize("engine", ["mujoco", "pybullet", "drake"])
 def test_an_engine_answers_the_same_twice_and_reports_its_own_velocity(engine):
     first = lawbench.solve(engine, "sphere_wall", options={"settings": "tuned"})

@@ -5,7 +5,8 @@ dispersion index: the Shannon entropy of the shares over its largest value,
 ``D = -sum s_b ln s_b / ln(number of bodies)``, 0 when one body carries all the energy (the
 textbook, non-dispersive outcome of a chain) and 1 when every body carries the same. The
 reference is the scene's ground truth when it is a converged model (``Case.ground_truth``: for
-the chains, compliant contacts at the scene's stiffnesses) on the same problem; the value is the
+the chains, compliant contacts at the scene's stiffnesses) on the same problem, solved once per
+process with the model error's (`lawbench.checks.solved`); the value is the
 largest difference of a share, and the outcome agrees with the reference when it is below 0.05.
 """
 
@@ -16,8 +17,8 @@ import math
 import numpy as np
 
 from lawbench.checks.outcome_checks import check
+from lawbench.checks.solved import velocity_after
 from lawbench.core.errors import LawbenchError
-from lawbench.core.law import LAWS
 from lawbench.core.mechanics import energy_shares
 from lawbench.core.trial import Trial
 
@@ -42,11 +43,11 @@ def dispersion(trial: Trial) -> tuple:
     if truth is None or truth.law is None:
         return None, None, "the scene declares no converged model as its ground truth"
     try:
-        reference = LAWS.get(truth.law).resolve(problem, **truth.options)
+        reference = velocity_after(truth.law, dict(truth.options), problem)
     except LawbenchError as exc:
         return None, None, f"no reference ({truth.law}): {type(exc).__name__}: {exc}"
     shares = energy_shares(problem, trial.outcome.v_plus)
-    expected = energy_shares(problem, reference.v_plus)
+    expected = energy_shares(problem, reference)
     value = max(abs(shares[b] - expected[b]) for b in shares)
     detail = (
         f"index {dispersion_index(shares):.3f} ({truth.law} {dispersion_index(expected):.3f}); "

@@ -4,7 +4,9 @@ A law names its accuracy knob in its tags (``accuracy_knob``: a tolerance, a num
 choice of method). `knob_values` is what a speed/accuracy sweep gives that knob, `tightest` the
 options of the law's own converged answer, the yardstick of its numerical error
 (`lawbench.checks.measures.numerical_error`). Both keep to the values the knob's `Spec`
-accepts, so a law whose tolerance stops at 1e-10 is never asked for 1e-12.
+accepts, so a law whose tolerance stops at 1e-10 is never asked for 1e-12, and to the finest
+time step a law declares (``Tags.finest_knob``): an engine stepped at 1e-12 s would need 1e10
+steps for a 10 ms impact, and ran into its step bound instead of answering.
 """
 
 from __future__ import annotations
@@ -46,7 +48,9 @@ def knob_values(law: Law, values: Sequence[float]) -> tuple[str | None, list[Any
     if spec.kind == "bool":
         return knob, [False, True]
     candidates = INT_KNOBS if spec.kind == "int" else values
-    return knob, [v for v in candidates if _accepts(spec, v)] or [spec.default]
+    finest = law.tags.finest_knob
+    kept = [v for v in candidates if _accepts(spec, v) and (finest is None or v >= finest)]
+    return knob, kept or [spec.default]
 
 
 def tightest(law: Law) -> dict[str, Any]:
@@ -57,6 +61,8 @@ def tightest(law: Law) -> dict[str, Any]:
         return {}
     if spec.kind == "int":
         return {knob: max(v for v in (*INT_KNOBS, spec.default) if _accepts(spec, v))}
+    if law.tags.finest_knob is not None:
+        return {knob: law.tags.finest_knob}
     accepted = [TIGHTEST * 10.0**k for k in range(12) if _accepts(spec, TIGHTEST * 10.0**k)]
     return {knob: accepted[0]} if accepted else {}
 

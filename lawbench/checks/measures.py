@@ -10,13 +10,13 @@
   (`lawbench.checks.knobs.tightest`), the same way; 0 for an exact law, None for a knob that chooses
   between models (an ordering) rather than an accuracy.
 
-Both solve again in the worker; each answer is kept per process, so a sweep pays for the
-ground truth once per worker. A measure returns None where it does not apply.
+Both solve again in the worker; each answer is kept per process (`lawbench.checks.solved`),
+so a sweep pays for the ground truth once per worker. A measure returns None where it does not
+apply.
 """
 
 from __future__ import annotations
 
-import json
 from typing import Any
 
 import numpy as np
@@ -24,45 +24,19 @@ import numpy as np
 from lawbench.checks.continuity import jumps
 from lawbench.checks.dispersion import dispersion_index as _index
 from lawbench.checks.knobs import tightest
+from lawbench.checks.solved import digest, velocity_after
 from lawbench.core.errors import LawbenchError
-from lawbench.core.law import LAWS
 from lawbench.core.mechanics import energy_shares as _shares
-from lawbench.core.metric import is_sparse
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import Trial
 
-# Answers solved again, per process: (law, options, problem) -> v_plus or None.
-_SOLVED: dict[str, np.ndarray | None] = {}
-
-
-def _digest(problem: ImpactProblem) -> str:
-    import hashlib  # on first use: it loads OpenSSL, 3 ms of a small command's start-up
-
-    digest = hashlib.sha1(repr(problem.contacts).encode())
-    for part in (problem.M, problem.Wn, problem.Wt, problem.v, problem.gaps):
-        if part is None:
-            continue
-        # A sparse matrix by its stored entries and their places (CSC, as the problem keeps it).
-        arrays = (part.data, part.indices, part.indptr) if is_sparse(part) else (part,)
-        for array in arrays:
-            digest.update(np.ascontiguousarray(array).tobytes())
-    return digest.hexdigest()
-
 
 def _solve(law: str, options: dict[str, Any], problem: ImpactProblem) -> np.ndarray | None:
-    """``law``'s post-impact velocity on ``problem``, once per process; None when it fails.
-
-    Answers are kept under the law's complete options, so a ground truth and a law's tightest
-    knob that name the same options differently are solved once.
-    """
-    values = LAWS.get(law).option_values(options)
-    key = json.dumps([law, values, _digest(problem)], sort_keys=True, default=str)
-    if key not in _SOLVED:
-        try:
-            _SOLVED[key] = LAWS.get(law).resolve(problem, **values).v_plus
-        except LawbenchError:
-            _SOLVED[key] = None
-    return _SOLVED[key]
+    """``law``'s post-impact velocity on ``problem``, once per process; None when it fails."""
+    try:
+        return velocity_after(law, options, problem)
+    except LawbenchError:
+        return None
 
 
 def _distance(trial: Trial, v: np.ndarray | None) -> float | None:
@@ -97,7 +71,7 @@ def _closed_form(trial: Trial, name: str) -> np.ndarray | None:
     reference = next(r for r in case.references if r.name == name)
     if reference.condition(trial.params) or any(trial.params.get("gaps", ())):
         return None
-    if _digest(case.build(**trial.params)) != _digest(trial.problem):
+    if digest(case.build(**trial.params)) != digest(trial.problem):
         return None
     return np.asarray(reference.v_plus(trial.params), dtype=float)
 

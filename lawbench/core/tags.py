@@ -35,6 +35,11 @@ class Tags:
         A law reads the contacts' stiffness and exponent; a scene's outcome depends on them.
     accuracy_knob : str or None
         For a law, the option that trades accuracy for cost; None for exact laws.
+    finest_knob : float or None
+        For a law whose accuracy knob is a time step, whose work grows as the step shrinks
+        with no bound of its own: the finest step a sweep gives it and the one its own
+        converged answer is taken at (`lawbench.checks.knobs.tightest`). None: the knob's
+        spec bounds it.
     """
 
     friction: bool = False
@@ -42,6 +47,7 @@ class Tags:
     spatial: bool = False
     stiffness: bool = False
     accuracy_knob: str | None = None
+    finest_knob: float | None = None
 
     def missing(self, required: Tags) -> list[str]:
         """The features ``required`` has and these tags do not treat, in words."""
