@@ -183,3 +183,22 @@ def test_a_ground_truth_and_a_tightest_knob_naming_the_same_options_are_solved_o
     short = measures._solve("compliant", {"tol": 1e-9}, problem)
     spelled = measures._solve("compliant", law.option_values({"tol": 1e-9}), problem)
     assert len(calls) == 1 and np.array_equal(short, spelled)
+
+
+def test_the_ground_truth_s_model_measured_against_itself_is_not_solved_again(monkeypatch):
+    """The compliant law at the ground truth's options is its own truth: its model error is 0
+    from its own answer, with no second solve; its numerical error still solves the tighter
+    knob."""
+    from lawbench.checks import measures, solved
+    from lawbench.core.trial import make_trial
+
+    trial = make_trial("compliant", "three_ball_chain", options={"max_seconds": 30.0})
+    law = type(trial.law)
+    calls = []
+    resolve = law.resolve
+    monkeypatch.setattr(
+        law, "resolve", lambda self, *a, **k: calls.append(1) or resolve(self, *a, **k)
+    )
+    monkeypatch.setattr(solved, "_SOLVED", {})
+    assert measures.model_error(trial) == 0.0 and not calls
+    assert 0.0 < measures.numerical_error(trial) < 1e-6 and len(calls) == 1

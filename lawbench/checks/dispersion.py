@@ -43,7 +43,7 @@ def dispersion(trial: Trial) -> tuple:
     if truth is None or truth.law is None:
         return None, None, "the scene declares no converged model as its ground truth"
     try:
-        reference = velocity_after(truth.law, dict(truth.options), problem)
+        reference = velocity_after(truth.law, dict(truth.options), problem, trial)
     except LawbenchError as exc:
         return None, None, f"no reference ({truth.law}): {type(exc).__name__}: {exc}"
     shares = energy_shares(problem, trial.outcome.v_plus)

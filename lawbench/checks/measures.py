@@ -31,10 +31,12 @@ from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import Trial
 
 
-def _solve(law: str, options: dict[str, Any], problem: ImpactProblem) -> np.ndarray | None:
+def _solve(
+    law: str, options: dict[str, Any], problem: ImpactProblem, trial: Trial | None = None
+) -> np.ndarray | None:
     """``law``'s post-impact velocity on ``problem``, once per process; None when it fails."""
     try:
-        return velocity_after(law, options, problem)
+        return velocity_after(law, options, problem, trial)
     except LawbenchError:
         return None
 
@@ -61,7 +63,7 @@ def truth(trial: Trial) -> np.ndarray | None:
         if closed is not None:
             return closed
     if ground.law is not None:
-        return _solve(ground.law, dict(ground.options), trial.problem)
+        return _solve(ground.law, dict(ground.options), trial.problem, trial)
     return None
 
 
@@ -89,7 +91,7 @@ def numerical_error(trial: Trial) -> float | None:
     tight = tightest(law)
     if not tight:
         return None
-    return _distance(trial, _solve(law.name, {**trial.options, **tight}, trial.problem))
+    return _distance(trial, _solve(law.name, {**trial.options, **tight}, trial.problem, trial))
 
 
 def truth_velocity(trial: Trial) -> list[float] | None:

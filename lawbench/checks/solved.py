@@ -4,7 +4,8 @@ The cells of a study share their scene's ground truth (the model error, the disp
 and a law's answer at its tightest knob (the numerical error): a worker solves each once. An
 answer is kept under the law's complete options and the problem's digest, so a ground truth
 and a tightest knob that name the same options differently are one solve; a failed solve is
-kept too, and raised again.
+kept too, and raised again. The trial being checked is an answer already: asked for its own
+law, options and problem (the ground truth's model checked against itself), it serves.
 """
 
 from __future__ import annotations
@@ -18,9 +19,12 @@ from lawbench.core.errors import LawbenchError
 from lawbench.core.law import LAWS
 from lawbench.core.metric import is_sparse
 from lawbench.core.problem import ImpactProblem
+from lawbench.core.trial import Trial
 
 # (law, options, problem digest) -> v_plus, or the error that stopped the solve.
 _SOLVED: dict[str, np.ndarray | LawbenchError] = {}
+# Options that bound a solve's wall-clock time without changing the answer it gives.
+BOUNDS = frozenset({"max_seconds"})
 
 
 def digest(problem: ImpactProblem) -> str:
@@ -38,8 +42,12 @@ def digest(problem: ImpactProblem) -> str:
     return found.hexdigest()
 
 
-def velocity_after(law: str, options: dict[str, Any], problem: ImpactProblem) -> np.ndarray:
+def velocity_after(
+    law: str, options: dict[str, Any], problem: ImpactProblem, trial: Trial | None = None
+) -> np.ndarray:
     """``law``'s post-impact velocity on ``problem`` with ``options``, solved once per process.
+
+    ``trial``'s own answer where it is that solve.
 
     Raises
     ------
@@ -47,6 +55,8 @@ def velocity_after(law: str, options: dict[str, Any], problem: ImpactProblem) ->
         The solve's own error, raised again on every later call.
     """
     values = LAWS.get(law).option_values(options)
+    if trial is not None and _is_solve_of(trial, law, values, problem):
+        return trial.outcome.v_plus
     key = json.dumps([law, values, digest(problem)], sort_keys=True, default=str)
     if key not in _SOLVED:
         try:
@@ -57,3 +67,13 @@ def velocity_after(law: str, options: dict[str, Any], problem: ImpactProblem) ->
     if isinstance(answer, LawbenchError):
         raise answer
     return answer
+
+
+def _is_solve_of(trial: Trial, law: str, values: dict[str, Any], problem: ImpactProblem) -> bool:
+    """Whether ``trial`` is ``law`` solved on ``problem`` with option ``values``, bounds aside."""
+    used = trial.outcome.diagnostics.get("options")
+    if trial.law.name != law or trial.problem is not problem or used is None:
+        return False
+    return {k: v for k, v in used.items() if k not in BOUNDS} == {
+        k: v for k, v in values.items() if k not in BOUNDS
+    }
