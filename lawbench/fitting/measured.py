@@ -57,8 +57,12 @@ from lawbench.studies.study import evenly
 # The accuracy knob of every law that has one, and the wall-clock budget of one solve.
 TOL = 1e-6
 MAX_SECONDS = 10.0
-# The least squares' tolerances and finite-difference step: above the laws' accuracy at `TOL`.
-FIT_TOL = 1e-6
+# The least squares' tolerances and finite-difference step, above the laws' accuracy at `TOL`. The
+# fit stops where the cost, the coefficients or the gradient change by less than `FIT_TOL`
+# relative: a Jacobian by differences of relative step `DIFF_STEP` resolves no finer. Asked for
+# 1e-6, the compliant law's fit on the cube's quick impacts took 28 s for the coefficients it
+# finds in 19 s at 1e-4, the same to 3e-4 (their standard errors: 0.05 and more).
+FIT_TOL = 1e-4
 DIFF_STEP = 1e-3
 # Where each fitted field starts: inside its range, friction moderate, Mindlin's stiffness ratio;
 # another field a law declares starts at the contact's default.
