@@ -43,8 +43,10 @@ KNOBS = (1e-2, 1e-6, 1e-10)
 # or more of the quick report's time for cells whose answer is that they are out of budget.
 QUICK_COSTLY_POINTS = 1
 QUICK_COSTLY = {"costly_points": QUICK_COSTLY_POINTS}
-# Perturbation sizes of the continuity sweep (quick and full).
-JUMP_SIZES = (1e-2, 1e-4, 1e-6)
+# Perturbation sizes of the continuity sweep (quick and full). The verdict reads the smallest;
+# the quick report shows one larger size beside it, each size costing every law on the scene
+# m + 3 solves again (a third of the laws' work in the quick continuity studies per size).
+JUMP_SIZES = (1e-2, 1e-6)
 FULL_JUMP_SIZES = tuple(10.0**-k for k in range(1, 9))
 
 
