@@ -26,6 +26,7 @@ from matplotlib.figure import Figure as MplFigure
 
 from lawbench.files.paths import replaced
 from lawbench.views.report.marks import COLOURS, GLYPHS, Mark, legend
+from lawbench.views.report.plots import lay_out_once
 
 LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
 CODE = re.compile(r"`([^`]+)`")
@@ -283,10 +284,10 @@ def save_figure(figure: MplFigure, name: str, data: pd.DataFrame, out: Path) -> 
     The page shows the vector image itself: a raster copy as well doubled the drawing time.
     """
     FigureCanvasAgg(figure)
-    # A tight bounding box keeps the legends placed outside the axes.
+    lay_out_once(figure)
     with rc_context({"svg.hashsalt": "lawbench"}):
         with replaced(out / f"{name}.svg", "report figure") as temporary:
-            figure.savefig(temporary, format="svg", metadata={"Date": None}, bbox_inches="tight")
+            figure.savefig(temporary, format="svg", metadata={"Date": None})
     with replaced(out / f"{name}.csv", "report table") as temporary:
         data.to_csv(temporary, index=False)
 

@@ -29,6 +29,8 @@ CSS_DPI = 96.0
 # 10 pt tick labels stay 13 px tall.
 MAX_WIDTH = 11.5
 LEGEND_FONT = "small"
+# Inches between the legend below the panels and the figure's edge, and the panels' labels.
+LEGEND_PAD = 0.1
 
 
 class PowersOfTen(LogFormatter):
@@ -119,13 +121,35 @@ def gather_legends(fig: Figure) -> None:
     fig.below = fig.legend(
         list(entries.values()),
         list(entries),
-        loc="upper center",
-        bbox_to_anchor=(0.5, 0.0),
+        loc="lower center",
+        bbox_to_anchor=(0.5, LEGEND_PAD / fig.get_figheight()),
         ncols=columns,
         fontsize=LEGEND_FONT,
         title=title,
         frameon=False,
     )
+
+
+def lay_out_once(fig: Figure) -> None:
+    """Lay ``fig`` out for saving, once: its legend below the panels in a band of its own.
+
+    The figure grows by the legend's height, the panels keeping their size above it; the layout
+    then runs and stays as it is. Saved with a layout engine, or with a tight bounding box around
+    a legend hanging below the figure, a figure is drawn twice.
+    """
+    gather_legends(fig)
+    engine = fig.get_layout_engine()
+    legend = getattr(fig, "below", None)
+    renderer = fig.canvas.get_renderer()
+    if legend is not None:
+        band = legend.get_window_extent(renderer).height / fig.dpi + 2 * LEGEND_PAD
+        height = fig.get_figheight() + band
+        fig.set_figheight(height)
+        engine.set(rect=(0.0, band / height, 1.0, 1.0))
+        gather_legends(fig)  # anchored anew at the grown figure's bottom
+    if engine is not None:
+        engine.execute(fig)
+        fig.set_layout_engine(None)
 
 
 def figure(rows: int, cols: int, width: float = 4.2, height: float = 3.2) -> tuple[Figure, Any]:
