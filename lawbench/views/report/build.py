@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import json
 import platform
+import threading
 import time
 import traceback
+from collections.abc import Callable
 from importlib.metadata import version
 from pathlib import Path
 from types import ModuleType
@@ -69,8 +71,11 @@ TITLE = "lawbench: impact laws compared"
 DRAWING_S = 300.0
 
 
-def _section(module: ModuleType, ctx: Context) -> Section:
+def _section(module: ModuleType, ctx: Context, failure: Exception | None = None) -> Section:
+    """The section ``module`` builds, or the one that says how it failed (``failure``)."""
     try:
+        if failure is not None:
+            raise failure
         return module.build(ctx)
     except Exception as exc:  # the other sections are still worth writing
         where = traceback.extract_tb(exc.__traceback__)[-1]
@@ -87,9 +92,14 @@ def build(out: Path, config: Config) -> Path:
     start = time.perf_counter()
     ctx = Context(config, out)
     ctx.run([view for module in SECTIONS for view in module.VIEWS])
+    # The measured studies run in their own workers while this process builds the other
+    # sections; the measured section is built once they are done.
+    measuring = _beside(measured.results, ctx)
     with Guard(config.workers, DRAWING_S) as drawing:
         drawing.start()  # the drawing workers start up while the sections are built
-        topics = {module.ANCHOR: _section(module, ctx) for module in SECTIONS}
+        built = {m.ANCHOR: _section(m, ctx) for m in SECTIONS if m is not measured}
+        built[measured.ANCHOR] = _section(measured, ctx, measuring())
+        topics = {module.ANCHOR: built[module.ANCHOR] for module in SECTIONS}
         first = answer_blocks(ctx)
         seconds = time.perf_counter() - start
         counts, *lists = headline(ctx)
@@ -97,6 +107,29 @@ def build(out: Path, config: Config) -> Path:
         sections = arrange(topics, [case.name for case in ctx.cases], health)
         write_page(out, TITLE, [*first, counts], sections, ctx.rerun, _save(drawing))
     return out
+
+
+def _beside(function: Callable[..., Any], *args: Any) -> Callable[[], Exception | None]:
+    """Start ``function(*args)`` in a thread; return what waits for it and gives its error.
+
+    A daemon thread: a run interrupted meanwhile ends without waiting for it.
+    """
+    error: list[Exception] = []
+
+    def run() -> None:
+        try:
+            function(*args)
+        except Exception as exc:  # the section says so
+            error.append(exc)
+
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+
+    def wait() -> Exception | None:
+        thread.join()
+        return error[0] if error else None
+
+    return wait
 
 
 def _save(guard: Guard) -> Any:
