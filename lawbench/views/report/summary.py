@@ -1,7 +1,8 @@
 """Section 1, the summary matrix: laws x scenes, the verdict of every check at the defaults.
 
 A view of the ``summary`` study: every law on every scene at its default parameters, with every
-check (continuity and dispersion included). Each cell holds one mark, the worst verdict of its
+check (continuity and dispersion included; the quick report leaves continuity to the continuity
+studies of the two chains). Each cell holds one mark, the worst verdict of its
 checks, with the symbols of the checks that have it and every check's reason on hover, so the
 matrix fits a page; a *law property* links to the finding that predicts it. A law that refuses
 the scene gets one *refused* mark, like a check that does not apply.
@@ -135,11 +136,16 @@ def build(ctx: Context) -> Section:
     refused = int((data["verdict"] == str(Verdict.REFUSED)).sum())
     key = ", ".join(f"{s} = {c}" for c, s in short.items())
     sizes = ", ".join(f"{s:g}" for s in study.settings.get("continuity_sizes", ()))
+    continuity = (
+        f"continuity perturbed at sizes {sizes}"
+        if "continuity" in checks
+        else "continuity in the continuity studies (here in the full report)"
+    )
     caption = (
         "Every law on every scene at the scene's default parameters, one mark per cell: the "
         "worst verdict of its checks (unexplained, numerical failure, budget, law property, "
         f"holds, refused, in that order), with the checks that have it; the key: {key}; "
-        f"continuity perturbed at sizes {sizes}. A mark's colour is its verdict (legend "
+        f"{continuity}. A mark's colour is its verdict (legend "
         "above); hover for every check's verdict and reason; a law property links to its "
         "finding. A law that gave no answer has its reason: refused (NotApplicable), a "
         "budget, or an error. The CSV holds every check's verdict and value."
