@@ -134,3 +134,23 @@ def test_evenly_spaced_values_keep_the_ends_and_one_is_the_first():
     assert evenly([1, 2, 3, 4, 5], 3) == [1, 3, 5]
     assert evenly([1, 2, 3], 1) == [1]
     assert evenly([1, 2], 5) == [1, 2] and evenly([1, 2], None) == [1, 2]
+
+
+def test_the_quick_speed_accuracy_study_measures_a_thinned_law_for_model_error_but_its_truth():
+    """In the quick report a law that follows the impact through time gets one point and no
+    numerical error (its tightest setting is the costliest solve of its sweep), except the ground
+    truth's own model, whose convergence the figure shows; the full report measures every
+    law."""
+    study = STUDIES["rocking_block_speed_accuracy"]
+    laws = ["moreau", "lzb", "compliant", "mujoco"]
+    quick = study.preset("quick").plan(laws, ["rocking_block"])
+    kept = {job.law: set(quick.measures_of(job)) for job in quick.jobs}
+    every = {"model_error", "numerical_error"}
+    assert kept == {
+        "moreau": every,
+        "lzb": {"model_error"},
+        "compliant": every,
+        "mujoco": {"model_error"},
+    }
+    full = study.preset("full").plan(laws, ["rocking_block"])
+    assert all(set(full.measures_of(job)) == every for job in full.jobs)

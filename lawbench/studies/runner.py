@@ -64,6 +64,11 @@ class Task:
     measures: Mapping[str, Measure] = field(default_factory=dict)
 
 
+def _task(plan: Plan, index: int, job: Job) -> Task:
+    """The task of ``plan``'s cell ``index``."""
+    return Task(index, job, plan.name, plan.checks, plan.settings, plan.measures_of(job))
+
+
 def compute(task: Task, alarm_s: float | None = None) -> dict[str, Any]:
     """The record row of one cell: outcome, checks, measures, cost, or the error that stopped it.
 
@@ -348,7 +353,7 @@ def _pending(
         done = set(finished["key"]) if len(finished) else set()
         for index, job in enumerate(plan.jobs):
             if job.key not in done:
-                tasks.append(Task(index, job, plan.name, plan.checks, plan.settings, plan.measures))
+                tasks.append(_task(plan, index, job))
                 owner.append(number)
     return tasks, owner
 
@@ -403,17 +408,14 @@ def estimate_seconds(sample: Plan, cells: int, workers: int) -> float:
         return 0.0
     start = time.perf_counter()
     for index, job in enumerate(sample.jobs):
-        compute(Task(index, job, sample.name, sample.checks, sample.settings, sample.measures))
+        compute(_task(sample, index, job))
     per_cell = (time.perf_counter() - start) / len(sample.jobs)
     return per_cell * cells / max(1, workers)
 
 
 def collect(plan: Plan, executor: Executor) -> pd.DataFrame:
     """Every record of ``plan``, in cell order, computed by ``executor`` (no file written)."""
-    tasks = [
-        Task(index, job, plan.name, plan.checks, plan.settings, plan.measures)
-        for index, job in enumerate(plan.jobs)
-    ]
+    tasks = [_task(plan, index, job) for index, job in enumerate(plan.jobs)]
     rows = [row for _, row in executor.run(tasks)]
     return pd.DataFrame(sorted(rows, key=lambda row: row["index"]))
 

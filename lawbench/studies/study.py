@@ -79,6 +79,12 @@ def costly(law: Law) -> bool:
     return law.engine or law.tags.stiffness
 
 
+def _is_truth(law: str, case: Case) -> bool:
+    """Whether ``case``'s ground truth is ``law``'s answer."""
+    truth = case.ground_truth
+    return truth is not None and truth.law == law
+
+
 def _cli(value: Any) -> str:
     """A value as ``--set`` reads it back exactly: lists comma-joined, floats in full."""
     if isinstance(value, list | tuple):
@@ -166,6 +172,13 @@ class Plan:
     checks: tuple[str, ...] = ()
     settings: Mapping[str, Any] = field(default_factory=dict)
     measures: Mapping[str, Measure] = field(default_factory=dict)
+    # Per law and scene, the measures their cells leave out (`Study.costly_measures`).
+    left_out: Mapping[tuple[str, str], frozenset[str]] = field(default_factory=dict)
+
+    def measures_of(self, job: Job) -> dict[str, Measure]:
+        """The measures of ``job``'s cell."""
+        skipped = self.left_out.get((job.law, job.case), frozenset())
+        return {name: m for name, m in self.measures.items() if name not in skipped}
 
 
 @dataclass(frozen=True)
@@ -224,6 +237,9 @@ class Study:
         that a law following the impact through time (`costly`) is given, evenly spaced
         (`evenly`), its accuracy knob at its default, the setting a user gets; None gives it
         every point and every knob value.
+    costly_measures : tuple of str or None
+        With ``costly_points``, the measures such a law's cells are given (None: every one),
+        but on a scene whose ground truth is that law's answer: the yardstick keeps them all.
     """
 
     name: str
@@ -247,6 +263,7 @@ class Study:
     full: Mapping[str, Any] = field(default_factory=dict)
     quick: Mapping[str, Any] = field(default_factory=dict)
     costly_points: int | None = None
+    costly_measures: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.laws, str) and self.laws not in LAW_CHOICES:
@@ -332,8 +349,22 @@ class Study:
 
     def plan(self, laws: Sequence[str] | None = None, cases: Sequence[str] | None = None) -> Plan:
         """The executor's plan of this study (restricted to ``laws`` and ``cases``)."""
+        from lawbench.core.case import CASES
+        from lawbench.core.law import LAWS
+
         jobs = list(self.jobs(laws, cases))
-        return Plan(self.name, jobs, self.check_names(), dict(self.settings), dict(self.measures))
+        left_out = {}
+        if self.costly_points is not None and self.costly_measures is not None:
+            skipped = frozenset(self.measures) - frozenset(self.costly_measures)
+            thinned = {
+                (job.law, job.case)
+                for job in jobs
+                if costly(LAWS.get(job.law)) and not _is_truth(job.law, CASES.get(job.case))
+            }
+            left_out = dict.fromkeys(sorted(thinned), skipped)
+        return Plan(
+            self.name, jobs, self.check_names(), dict(self.settings), dict(self.measures), left_out
+        )
 
     def _check(self, case: Case, law: Law, params: dict, options: dict) -> None:
         try:

@@ -109,6 +109,19 @@ def _thinning(left: dict[str, tuple[int, int | None]]) -> list[str]:
     ]
 
 
+def _measured_less(studies: list[Study]) -> list[str]:
+    """A note on the studies that measure the costly laws' cells for fewer quantities."""
+    if not studies:
+        return []
+    kept = sorted({name for s in studies for name in s.costly_measures or ()})
+    names = ", ".join(f"`{s.name}`" for s in studies)
+    return [
+        f"in {names} those laws' cells are measured for {', '.join(kept)} only, but the "
+        "ground truth's own model's: their numerical error, against their tightest setting "
+        "(the costliest solve of a sweep), is in the full report"
+    ]
+
+
 def _values(points: int | None) -> str:
     """Which values of an axis `lawbench.studies.study.evenly` keeps, in words."""
     if points == 1:
@@ -170,6 +183,7 @@ class Context:
             else:
                 self.left_out[study.name] = "none of its laws and scenes is selected"
         self.notes += _thinning(thinned)
+        self.notes += _measured_less([s for s in self.studies if s.costly_measures is not None])
         if not full:
             shutil.rmtree(self.out / "runs", ignore_errors=True)
         executor = Executor(
