@@ -71,7 +71,7 @@ PARTS = {
     "{% for b in block.blocks %}{{ render(b) }}{% endfor %}</details>",
     "table": '<div class="scroll"><table id="{{ block.name }}"'
     '{% if block.css %} class="{{ block.css }}"{% endif %}><thead><tr>'
-    "{% for c in block.frame.columns %}<th>{{ c }}</th>{% endfor %}</tr></thead><tbody>"
+    "{% for c in block.frame.columns %}<th>{{ c | unbroken }}</th>{% endfor %}</tr></thead><tbody>"
     '{% for row in rows %}<tr{% if row.anchor %} id="{{ row.anchor }}"{% endif %}>'
     "{% for c in row.cells %}<td>{{ c }}</td>{% endfor %}</tr>{% endfor %}</tbody></table></div>"
     '<p class="caption">{{ caption | inline }}</p>',
@@ -182,6 +182,15 @@ def _css(verdict: Any) -> str:
     return "v-" + str(verdict).replace(" ", "-")
 
 
+# The minus sign of a number's exponent (1e-06): a browser may break a line after a hyphen.
+_EXPONENT_SIGN = re.compile(r"(?<=\de)-(?=\d)")
+
+
+def _unbroken(text: Any) -> str:
+    """A header's text with its numbers' exponent signs as non-breaking hyphens."""
+    return _EXPONENT_SIGN.sub("\u2011", str(text))
+
+
 def _blank(value: Any) -> bool:
     return value is None or (isinstance(value, float) and value != value)
 
@@ -192,7 +201,7 @@ class _Html:
     def __init__(self, rerun: str) -> None:
         self.rerun = rerun
         env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined)
-        env.filters.update(inline=_inline, css=_css)
+        env.filters.update(inline=_inline, css=_css, unbroken=_unbroken)
         self.env = env
         self.parts = {name: env.from_string(text) for name, text in PARTS.items()}
 
