@@ -19,8 +19,8 @@ refuses an impact; a `SolverFailure` is counted, its impact left out of the erro
 Cost: a fit solves the law tens of times per training impact. A law that integrates the
 impact through time (one that reads the contacts' stiffness, ``tags.stiffness``: tens to
 hundreds of milliseconds a solve, against about one for a closed form) is fitted on a fixed,
-evenly spaced subsample of `COSTLY_FIT` training impacts and judged on `COSTLY_JUDGE` test
-impacts; the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK`
+evenly spaced subsample of `COSTLY_FIT` training impacts and judged on every test impact
+(`COSTLY_JUDGE`); the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK`
 impacts of each half, evenly spaced, and `QUICK_COSTLY_FIT` and `QUICK_COSTLY_JUDGE` of them for
 a law that integrates in time. Rows judged on different impacts are ranked on the impacts every
 row solved (`ranked`). ``workers`` processes study the laws side by side.
@@ -67,9 +67,10 @@ DIFF_STEP = 1e-3
 # Where each fitted field starts: inside its range, friction moderate, Mindlin's stiffness ratio;
 # another field a law declares starts at the contact's default.
 START = {"e": 0.5, "e_t": 0.0, "mu": 0.2, "tangential_stiffness_ratio": MINDLIN_RATIO}
-# The impacts a law that integrates in time is fitted and judged on.
+# The impacts a law that integrates in time is fitted and judged on (None: every test impact, so
+# that its held-out error is the other laws'; on the cube's 174, 154 s for the compliant law).
 COSTLY_FIT = 8
-COSTLY_JUDGE = 40
+COSTLY_JUDGE: int | None = None
 # The same in the quick mode.
 QUICK_COSTLY_FIT = 2
 QUICK_COSTLY_JUDGE = 4
@@ -362,7 +363,7 @@ class _Halves:
         return cls(train, test, len(train), len(test), False)
 
     @property
-    def costly(self) -> tuple[int, int]:
+    def costly(self) -> tuple[int, int | None]:
         """How many impacts a law that integrates in time is fitted and judged on."""
         return (QUICK_COSTLY_FIT, QUICK_COSTLY_JUDGE) if self.quick else (COSTLY_FIT, COSTLY_JUDGE)
 

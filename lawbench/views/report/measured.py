@@ -501,8 +501,8 @@ def _mode_text(found: Found) -> str:
     else:
         sample = (
             f"every impact of each set (a law that reads stiffness is fitted on "
-            f"{measured.COSTLY_FIT} training impacts and judged on {measured.COSTLY_JUDGE} "
-            "test impacts, evenly spaced) and Kharaz's curves on the fine grid"
+            f"{measured.COSTLY_FIT} evenly spaced training impacts and judged on every test "
+            "impact) and Kharaz's curves on the fine grid"
         )
     return (
         f"Computed in {found.seconds:.0f} s with {found.workers} worker processes, one task "
