@@ -466,7 +466,12 @@ def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
             "kharaz_reversal",
             "Whether each law's contact point leaves the anvil moving backwards (contact angle "
             f"below -{kharaz_curves.REVERSED:g} deg) somewhere in the sticking range, as "
-            "measured (down to -8.5 deg at 20 deg): the lowest angle and its incidence.",
+            "measured (down to -8.5 deg at 20 deg): the lowest angle and its incidence. "
+            "Finding (Maw, Barber and Fawcett, Wear 38, 1976; Kharaz, Gorham and Salman, "
+            "Powder Technology 120, 2001): the contact's tangential compliance stores energy "
+            "while it sticks and gives it back reversed, so the laws with tangential springs "
+            "reverse and a rigid law with Coulomb friction, which ends a sticking impact at zero "
+            "slip, leaves the contact point at rest.",
             reversal_shown,
             reversal,
         ),
