@@ -16,6 +16,7 @@ import pandas as pd
 
 from lawbench.core.verdicts import Verdict
 from lawbench.studies.record import budget_text
+from lawbench.studies.study import Study
 from lawbench.views.report.marks import Mark
 from lawbench.views.report.page import Legend, Section, Table
 from lawbench.views.report.runs import Context
@@ -97,6 +98,26 @@ def _mark(row: dict[str, Any], checks: list[str], short: dict, by_key: dict) -> 
     return Mark(text, worst, reason, link)
 
 
+def _caption(study: Study, short: dict[str, str]) -> str:
+    """The matrix's caption: how to read a mark, the checks' key, where continuity is probed."""
+    key = ", ".join(f"{s} = {c}" for c, s in short.items())
+    sizes = ", ".join(f"{s:g}" for s in study.settings.get("continuity_sizes", ()))
+    continuity = (
+        f"continuity perturbed at sizes {sizes}"
+        if "continuity" in short
+        else "continuity in the continuity studies (here in the full report)"
+    )
+    return (
+        "Every law on every scene at the scene's default parameters, one mark per cell: the "
+        "worst verdict of its checks (unexplained, numerical failure, budget, law property, "
+        f"holds, refused, in that order), with the checks that have it; the key: {key}; "
+        f"{continuity}. A mark's colour is its verdict (legend "
+        "above); hover for every check's verdict and reason; a law property links to its "
+        "finding. A law that gave no answer has its reason: refused (NotApplicable), a "
+        "budget, or an error. The CSV holds every check's verdict and value."
+    )
+
+
 def build(ctx: Context) -> Section:
     """The section, from the ``summary`` study's table."""
     tables = ctx.tables("summary")
@@ -134,22 +155,6 @@ def build(ctx: Context) -> Section:
     ran = data[data["status"] == "ran"]
     counts = {v: int((ran[checks] == str(v)).sum().sum()) for v in Verdict}
     refused = int((data["verdict"] == str(Verdict.REFUSED)).sum())
-    key = ", ".join(f"{s} = {c}" for c, s in short.items())
-    sizes = ", ".join(f"{s:g}" for s in study.settings.get("continuity_sizes", ()))
-    continuity = (
-        f"continuity perturbed at sizes {sizes}"
-        if "continuity" in checks
-        else "continuity in the continuity studies (here in the full report)"
-    )
-    caption = (
-        "Every law on every scene at the scene's default parameters, one mark per cell: the "
-        "worst verdict of its checks (unexplained, numerical failure, budget, law property, "
-        f"holds, refused, in that order), with the checks that have it; the key: {key}; "
-        f"{continuity}. A mark's colour is its verdict (legend "
-        "above); hover for every check's verdict and reason; a law property links to its "
-        "finding. A law that gave no answer has its reason: refused (NotApplicable), a "
-        "budget, or an error. The CSV holds every check's verdict and value."
-    )
     summary = (
         f"{len(data)} law-scene cells: {len(ran)} solved, {refused} refused by the law. "
         "Check verdicts of the solved cells: "
@@ -166,7 +171,7 @@ def build(ctx: Context) -> Section:
         [
             summary,
             Legend(),
-            Table("comparison", caption, frame, data),
+            Table("comparison", _caption(study, short), frame, data),
             "Findings: what each law's theory predicts to fail, with the region where it "
             "applies and its source (the test suite holds every finding at its witnesses).",
             Table(
