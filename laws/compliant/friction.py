@@ -63,6 +63,12 @@ its 60 s at ``tangential_stiffness_ratio`` 0.25 and below at tol = 1e-6, 0.1 and
 its spin at ratio 0.25 and tol = 1e-8. Now it is answered at every ratio from 0.02 to 10, within
 1e-7 of its tol = 1e-12 answer at tol = 1e-6 and within 2e-9 at tol = 1e-8 (velocities relative
 to the largest pre-impact one); the scenes above keep their steps.
+
+A slip that stops where its speed only touches zero leaves the sticking stretch on its cone to
+second order, and the integrator's own error (in LSODA's low-order first steps) can
+carry it past: were the stick to end there, the slip it starts would run backward, stick again,
+and the contact would restart without advancing. So a sticking stretch reaches its cone only
+past the integrator's relative tolerance, and is put back on the cone as it starts to slide.
 """
 
 from __future__ import annotations
@@ -364,8 +370,9 @@ class _Mode:
         self.sticking = closed & ~slipping & (integration.mu > 0)
         self.damped = integration.clipped and bool(integration.c[closed].any())
         self.plastic = closed & integration.plastic
-        # A gap fires as it passes its band away from its side; a stretch reaching the cone and
-        # a slip speed falling to zero fire as they fall below zero; a 3D slip's follow margin
+        # A gap fires as it passes its band away from its side; a sticking stretch as it passes
+        # its cone by the integrator's relative tolerance, and a slip speed as it falls below
+        # zero; a 3D slip's follow margin
         # as it leaves the side it started on; a plastic contact's gap rate as it turns from
         # approach to separation.
         gaps = np.where(closed, 1.0, -1.0)
@@ -391,7 +398,7 @@ class _Mode:
         narrow = self.slipping & (integration.short > 0)
         parts = [
             g + integration.band,
-            np.where(self.sticking, at["radius"] - at["size"], 1.0),
+            np.where(self.sticking, at["radius"] * (1 + integration.rtol) - at["size"], 1.0),
             np.where(self.slipping, at["lam"], 1.0),
             np.where(narrow, integration.follow_margin(y, at["radius"]), -1.0),
             np.where(self.plastic, un, -1.0),
