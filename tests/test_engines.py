@@ -22,6 +22,7 @@ from lawbench.core.geometry import Body, ContactPair, Geometry, Joint
 from lawbench.core.law import Law
 from lawbench.core.registry import Registry
 from lawbench.core.transforms import duplicated
+from lawbench.measurements import MEASUREMENTS
 from lawbench.views import cli
 
 pybullet = pytest.importorskip("pybullet")
@@ -242,14 +243,37 @@ COLUMNS = {
 }
 
 
-@pytest.mark.parametrize(("case", "params"), SCENES)
-@pytest.mark.parametrize("engine", list(COLUMNS))
-def test_the_engine_s_contact_jacobians_are_the_scene_s(engine, case, params):
-    problem = lawbench.CASES.get(case).build(**params)
+def assert_engine_columns(engine, problem):
+    """The engine's contact Jacobians at the problem's pose are its ``Wn`` and ``Wt`` to 1e-9."""
     Wn, Wt = COLUMNS[engine](problem)
     np.testing.assert_allclose(Wn, problem.Wn, atol=1e-9 * np.abs(problem.Wn).max())
     if problem.Wt is not None:
         np.testing.assert_allclose(Wt, problem.Wt, atol=1e-9 * np.abs(problem.Wt).max())
+
+
+@pytest.mark.parametrize(("case", "params"), SCENES)
+@pytest.mark.parametrize("engine", list(COLUMNS))
+def test_the_engine_s_contact_jacobians_are_the_scene_s(engine, case, params):
+    assert_engine_columns(engine, lawbench.CASES.get(case).build(**params))
+
+
+def test_every_cube_toss_is_its_geometry_s():
+    """The ContactNets cube tosses (Pfrommer, Halm and Posa, CoRL 2020) carry their geometry:
+    the cube a box at its measured pose, the table a plane through its lowest touching vertex.
+    Every kept impact's problem is that geometry's linear algebra."""
+    impacts = MEASUREMENTS.get("cube").impacts
+    assert len(impacts) == 348
+    for impact in impacts:
+        assert _base.geometry_mismatch(impact.problem.geometry, impact.problem) is None
+
+
+@pytest.mark.parametrize("toss", [50, 473])
+@pytest.mark.parametrize("engine", list(COLUMNS))
+def test_the_engine_s_contact_jacobians_are_a_cube_toss_s(engine, toss):
+    """One-corner impacts of the cube set, the box turned to its measured orientation."""
+    impact = next(i for i in MEASUREMENTS.get("cube").impacts if i.index == toss)
+    assert impact.problem.m == 1
+    assert_engine_columns(engine, impact.problem)
 
 
 @pytest.mark.parametrize(

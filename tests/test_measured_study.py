@@ -10,7 +10,14 @@ from lawbench.core.errors import InvalidProblem, NotApplicable
 from lawbench.core.law import LAWS
 from lawbench.core.problem import CONTACT_RANGES
 from lawbench.fitting import heldout
-from lawbench.fitting.measured import COLUMNS, evenly, measured_study, predict, ranked
+from lawbench.fitting.measured import (
+    COLUMNS,
+    evenly,
+    measured_study,
+    predict,
+    ranked,
+    study_options,
+)
 from lawbench.measurements import MEASUREMENTS, MeasurementSet, Processing
 from lawbench.views.cli import main
 
@@ -202,3 +209,20 @@ def test_a_study_needs_a_worker():
     """Fewer than one worker is refused by name."""
     with pytest.raises(InvalidProblem, match="workers = 0"):
         measured_study("kharaz", ["whittaker"], workers=0)
+
+
+def test_an_engine_is_fitted_through_the_set_s_geometry():
+    """The cube tosses carry their geometry, so an engine is fitted and judged like a law, the
+    pairs taking each trial's coefficients (an engine refuses a problem whose coefficients are
+    not its geometry's). A set made by PyBullet at its tuned settings, e = 0.4 and mu = 0.3, on
+    one-corner impacts is fitted back to them."""
+    pytest.importorskip("pybullet")
+    law = LAWS.get("pybullet")
+    one = [i for i in MEASUREMENTS.get("cube").impacts if i.problem.m == 1][:12]
+    velocities, failures = predict(law, one, {"e": 0.4, "mu": 0.3}, study_options(law))
+    assert not failures
+    made = [dataclasses.replace(i, v_after=v) for i, v in zip(one, velocities, strict=True)]
+    study = measured_study(small_set(made[:6], made[6:]), ["pybullet"])
+    row = study.table.set_index("law").loc["pybullet"]
+    assert row["e"] == pytest.approx(0.4, abs=1e-3) and row["mu"] == pytest.approx(0.3, abs=1e-3)
+    assert row["median_error"] < 1e-3 and row["refused"] == 0

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -403,6 +403,14 @@ class Geometry:
     def d(self) -> int:
         """Tangents per contact: 0 without friction, 1 planar, 2 spatial."""
         return len(self.pairs[0].tangents)
+
+    def with_coefficients(self, e: Sequence[float], mu: Sequence[float]) -> Geometry:
+        """The same geometry, its pair j of restitution ``e[j]`` and friction ``mu[j]``."""
+        pairs = tuple(
+            replace(pair, e=float(ej), mu=float(mj))
+            for pair, ej, mj in zip(self.pairs, e, mu, strict=True)
+        )
+        return replace(self, pairs=pairs)
 
     def joint(self, body: str) -> Joint:
         """The joint of ``body``."""

@@ -16,9 +16,10 @@ noise) and a per-solve budget of `MAX_SECONDS`. A law that fits no friction coef
 refused on impacts measured with friction (a tangential row), and a law's own `NotApplicable`
 refuses an impact; a `SolverFailure` is counted, its impact left out of the errors.
 
-Cost: a fit solves the law tens of times per training impact. A law that integrates the
-impact through time (one that reads the contacts' stiffness, ``tags.stiffness``: tens to
-hundreds of milliseconds a solve, against about one for a closed form) is fitted on a fixed,
+Cost: a fit solves the law tens of times per training impact. A law that follows the impact
+through time (an engine stepping the set's geometry, or a law that reads the contacts'
+stiffness: `lawbench.studies.study.costly`; milliseconds to hundreds of milliseconds a solve,
+against microseconds for a closed form) is fitted on a fixed,
 evenly spaced subsample of `COSTLY_FIT` training impacts and judged on every test impact
 (`COSTLY_JUDGE`); the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK`
 impacts of each half, evenly spaced, and `QUICK_COSTLY_FIT` and `QUICK_COSTLY_JUDGE` of them for
@@ -45,14 +46,14 @@ from lawbench.core.batch import COEFFICIENTS as BATCH_COEFFICIENTS
 from lawbench.core.batch import ProblemBatch
 from lawbench.core.errors import InvalidProblem, LawbenchError, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
-from lawbench.core.problem import CONTACT_RANGES, MINDLIN_RATIO, Contact
+from lawbench.core.problem import CONTACT_RANGES, MINDLIN_RATIO, Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.fitting import heldout
 from lawbench.fitting.coefficients import Free, start_point
 from lawbench.fitting.model import least_squares
 from lawbench.fitting.uncertainty import FLAT_TOL, summarize
 from lawbench.measurements import MEASUREMENTS, MeasuredImpact, MeasurementSet
-from lawbench.studies.study import evenly
+from lawbench.studies.study import costly, evenly
 
 # The accuracy knob of every law that has one, and the wall-clock budget of one solve.
 TOL = 1e-6
@@ -160,15 +161,23 @@ def predict(
     if law.vectorizes_batches and set(coefficients) <= set(BATCH_COEFFICIENTS):
         alone = _predict_batches(law, impacts, coefficients, options, velocities)
     for k in alone:
-        problem = impacts[k].problem
-        contacts = tuple(dataclasses.replace(c, **coefficients) for c in problem.contacts)
         try:
-            outcome = law.resolve(dataclasses.replace(problem, contacts=contacts), **options)
+            outcome = law.resolve(with_coefficients(impacts[k].problem, coefficients), **options)
         except (NotApplicable, SolverFailure) as exc:
             failures[k] = exc
             continue
         velocities[k] = outcome.v_plus
     return velocities, failures
+
+
+def with_coefficients(problem: ImpactProblem, coefficients: Mapping[str, float]) -> ImpactProblem:
+    """``problem`` with ``coefficients`` set on every contact, and on its geometry's pairs."""
+    contacts = tuple(dataclasses.replace(c, **coefficients) for c in problem.contacts)
+    geometry = problem.geometry
+    if geometry is not None:
+        e = [c.restitution("kinematic") for c in contacts]
+        geometry = geometry.with_coefficients(e, [c.mu for c in contacts])
+    return dataclasses.replace(problem, contacts=contacts, geometry=geometry)
 
 
 def _predict_batches(
@@ -252,9 +261,17 @@ class _Model:
 
 
 def study_options(law: Law) -> dict[str, Any]:
-    """The law's options in the study: ``tol`` at `TOL` where it has it, a budget per solve."""
+    """The law's options in the study: ``tol`` at `TOL` where it has it, a budget per solve.
+
+    An engine steps at its ``tuned`` settings, where ``e`` and ``mu`` set its own parameters
+    (MuJoCo's solref damping, PyBullet's restitution and friction, Drake's Hunt-Crossley
+    dissipation and friction): at their defaults MuJoCo and Drake ignore ``e``, and a fit of it
+    finds nothing.
+    """
     names = {spec.name for spec in law.options}
     given = {"tol": TOL} if "tol" in names else {}
+    if law.engine:
+        given["settings"] = "tuned"
     return law.option_values({**given, "max_seconds": MAX_SECONDS})
 
 
@@ -391,8 +408,7 @@ def _screen(
         if problem.Wt is not None and "mu" not in law.fitted:
             reason = "fits no friction coefficient, and the impacts were measured with friction"
         else:
-            contacts = tuple(dataclasses.replace(c, **coefficients) for c in problem.contacts)
-            reason = law.refusal(dataclasses.replace(problem, contacts=contacts))
+            reason = law.refusal(with_coefficients(problem, coefficients))
         if reason:
             refused[f"{law.name}: {reason}"] += 1
         else:
@@ -410,7 +426,7 @@ def _study_law(
     train, refused_train = _screen(law, halves.train, start)
     test, refused_test = _screen(law, halves.test, start)
     fitted = None
-    fit_count, judge_count = halves.costly if law.tags.stiffness else (None, None)
+    fit_count, judge_count = halves.costly if costly(law) else (None, None)
     if train and test:
         fitted, fitted_on, refused_fit = _fit(law, free, start, evenly(train, fit_count))
         refused_train += refused_fit

@@ -11,13 +11,21 @@ The raw samples hold the angular velocity in the body frame (the source's state 
 quaternion w, x, y, z; position; body-axes angular velocity; world-axes linear velocity). The
 extraction does not read those columns: it fits the world-frame angular velocity to the
 orientations, the frame the Jacobian's rows ``(e, r x e)`` need.
+
+Geometry, for the engines: the cube a box at the measured pose, with a free joint, and the
+table a fixed plane through the lowest touching vertex; contact j at touching vertex j, normal
+z, tangents x and y. The generalized velocity is the cube's body velocity itself. A second
+vertex of a compound impact lies up to 2 mm above the table there, and lands as the cube turns.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from lawbench.core.geometry import Body, ContactPair, Geometry, Joint
 from lawbench.measurements.impacts import (
     MEASUREMENTS,
     MeasuredImpact,
@@ -56,15 +64,37 @@ def _load() -> tuple[list[MeasuredImpact], np.ndarray, Processing]:
     for row, toss in enumerate(data["toss"]):
         rotation = Rotation.from_quat(data["quaternion"][row])
         offsets = rotation.apply(VERTICES[data["touching"][row]])
-        problem = vertex_problem(MASS, INERTIA, offsets, data["v_before"][row])
+        position = data["position"][row]
+        problem = dataclasses.replace(
+            vertex_problem(MASS, INERTIA, offsets, data["v_before"][row]),
+            geometry=_geometry(position, rotation, offsets),
+        )
         facts = {
             "fit_residuals_m": tuple(data["fit_residuals"][row, :2]),
             "fit_residuals_rad": tuple(data["fit_residuals"][row, 2:]),
             "compound": bool(data["compound"][row]),
-            "position": data["position"][row],
+            "position": position,
         }
         impacts.append(MeasuredImpact(problem, data["v_after"][row], None, NAME, int(toss), facts))
     return impacts, data["train"], processing_from(data)
+
+
+def _geometry(position: np.ndarray, rotation: Rotation, offsets: np.ndarray) -> Geometry:
+    """The cube at ``position`` turned by ``rotation``, touching the table at ``offsets``.
+
+    The pairs' coefficients are the problem's placeholders, ``e = 0`` and ``mu = 0``.
+    """
+    x, y, z, w = rotation.as_quat()
+    cube = Body("cube", "box", (SIDE / 2,) * 3, MASS, (INERTIA,) * 3, tuple(position), (w, x, y, z))
+    table = Body("table", "plane", (), position=(0.0, 0.0, position[2] + offsets[:, 2].min()))
+    axes = [tuple(axis) for axis in np.eye(3)]
+    pairs = tuple(
+        ContactPair("cube", "table", tuple(position + r), axes[2], tuple(axes[:2]), 0.0, 0.0)
+        for r in offsets
+    )
+    joints = (Joint("free", "cube"), Joint("fixed", "table"))
+    to_bodies = np.vstack([np.eye(6), np.zeros((6, 6))])
+    return Geometry((cube, table), joints, pairs, to_bodies, to_bodies.T)
 
 
 CUBE = MEASUREMENTS.register(

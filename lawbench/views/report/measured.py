@@ -38,6 +38,7 @@ from lawbench.fitting import heldout, kharaz_curves, measured
 from lawbench.fitting.measured import MeasuredStudy, measured_study
 from lawbench.measurements import MEASUREMENTS, MeasurementSet
 from lawbench.studies.guard import TIME_OUT, Guard, Result
+from lawbench.studies.study import costly
 from lawbench.views.report import plots
 from lawbench.views.report.marks import Mark
 from lawbench.views.report.page import Block, Figure, Section, Table, number
@@ -48,8 +49,9 @@ ANCHOR, TITLE, VIEWS = "measured", "Against measurements", ()
 BUDGET_S = {"quick": 240.0, "full": 6.0 * 3600.0}
 # The roles of the three rows drawn against the measurements, in the order of the legend.
 ROLES = ("best law", "best rigid law", "best compliant law")
-# Seconds the study of a law that reads stiffness may take in the quick report: a fit solves
-# each impact a hundred times or more, at 0.03 to 0.5 s a solve, so the quick page shows what
+# Seconds the study of a law that follows the impact through time (an engine, or a law that
+# reads stiffness) may take in the quick report: a fit solves each impact a hundred times or
+# more, at 0.01 to 0.5 s a solve, so the quick page shows what
 # such a law gives in that time (on `lawbench.fitting.measured.QUICK_COSTLY_FIT` and
 # `QUICK_COSTLY_JUDGE` impacts of the quick subsample) and the full page the rest.
 STIFF_QUICK_S = 30.0
@@ -122,12 +124,13 @@ def tasks(
 ) -> list[tuple[str, list[str], float]]:
     """The studies of one set: the laws that read no stiffness together, then each other law.
 
-    A law that reads stiffness integrates each impact in time, hundreds of times slower than
-    a closed form: it runs alone, so that the pool spreads the set's work, and in the quick
-    report within `STIFF_QUICK_S`. Each task is ``(set name, laws, seconds)``.
+    A law that follows the impact through time (an engine, or one that reads stiffness) is
+    tens to hundreds of times slower than a closed form: it runs alone, so that the pool
+    spreads the set's work, and in the quick report within `STIFF_QUICK_S`. Each task is
+    ``(set name, laws, seconds)``.
     """
     mode = "quick" if quick else "full"
-    stiff = [name for name in names if LAWS.get(name).tags.stiffness]
+    stiff = [name for name in names if costly(LAWS.get(name))]
     rigid = [name for name in names if name not in stiff]
     seconds = STIFF_QUICK_S if quick else BUDGET_S[mode]
     return [
@@ -266,7 +269,8 @@ def chosen(study: MeasuredStudy) -> dict[tuple[str, str], list[str]]:
     """The rows drawn against the measurements: ``(law, coefficients)`` -> their roles.
 
     The best law, the best law that reads no stiffness and the best that does, by rank,
-    among the registered laws with an answer; a row that is best in two roles is drawn once.
+    among the registered laws with an answer (an engine is none of these: its rows stand in
+    the table); a row that is best in two roles is drawn once.
     """
     picks: dict[tuple[str, str], list[str]] = {}
     tests = {
@@ -275,7 +279,11 @@ def chosen(study: MeasuredStudy) -> dict[tuple[str, str], list[str]]:
         ROLES[2]: lambda stiff: stiff,
     }
     answered = study.table[study.table["median_error"].notna()]
-    registered = [r for r in answered.to_dict("records") if r["law"] in LAWS.names()]
+    registered = [
+        r
+        for r in answered.to_dict("records")
+        if r["law"] in LAWS.names() and not LAWS.get(r["law"]).engine
+    ]
     for role, test in tests.items():
         row = next((r for r in registered if test(LAWS.get(r["law"]).tags.stiffness)), None)
         if row is not None:
