@@ -22,6 +22,7 @@ from lawbench.core.geometry import Body, ContactPair, Geometry, Joint
 from lawbench.core.law import Law
 from lawbench.core.registry import Registry
 from lawbench.core.transforms import duplicated
+from lawbench.fitting import kharaz_curves
 from lawbench.measurements import MEASUREMENTS
 from lawbench.views import cli
 
@@ -265,6 +266,12 @@ def test_every_cube_toss_is_its_geometry_s():
     assert len(impacts) == 348
     for impact in impacts:
         assert _base.geometry_mismatch(impact.problem.geometry, impact.problem) is None
+
+
+@pytest.mark.parametrize("engine", list(COLUMNS))
+def test_the_engine_s_contact_jacobians_are_kharaz_s_sphere_s(engine):
+    """Kharaz's alumina sphere on the glass anvil at 45 degrees, moving in its plane."""
+    assert_engine_columns(engine, kharaz_curves.impact_problem(45.0))
 
 
 @pytest.mark.parametrize("toss", [50, 473])

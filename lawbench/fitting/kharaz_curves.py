@@ -2,7 +2,8 @@
 
 The measured setup (`lawbench.measurements.sets.kharaz`): a 5 mm alumina sphere without spin
 strikes a glass anvil at 3.9 m/s at incidences from the normal to grazing. Every registered law
-whose tags treat one frictional planar contact solves it through the one way into a solve, with
+whose tags treat one frictional planar contact solves it through the one way into a solve (the
+engines too, at their default settings: the problem carries the setup's geometry), with
 the coefficients DEM benchmarks use for this pair, ``e = 0.98`` and ``mu = 0.092``, every other
 contact field at its default, and where a law reads stiffness Hertz's ``K = 4/3 E* R^(1/2)``
 (exponent 1.5) for alumina (E = 380 GPa, nu = 0.23) on soda-lime glass (70 GPa, 0.25), the
@@ -53,6 +54,7 @@ to normal frequency ratio ``(7/2 / eta0^2)^(1/2)`` = 1.7 over half a normal peri
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -99,9 +101,12 @@ def hertz_stiffness(radius: float = kharaz.SETUP.radius) -> float:
 
 
 def impact_problem(incidence: float) -> ImpactProblem:
-    """The measured impact at ``incidence`` degrees, with the benchmarks' coefficients."""
+    """The measured impact at ``incidence`` degrees, with the benchmarks' coefficients.
+
+    It carries the setup's geometry, for the engines.
+    """
     setup = kharaz.SETUP
-    return ImpactProblem.from_arrays(
+    problem = ImpactProblem.from_arrays(
         setup.mass_matrix(),
         [[0.0], [1.0], [0.0]],
         setup.velocity_before(incidence),
@@ -111,6 +116,8 @@ def impact_problem(incidence: float) -> ImpactProblem:
         stiffness=hertz_stiffness(setup.radius),
         exponent=HERTZ,
     )
+    geometry = setup.geometry(NORMAL_RESTITUTION, FRICTION)
+    return dataclasses.replace(problem, geometry=geometry)
 
 
 def frictional_laws() -> list[str]:

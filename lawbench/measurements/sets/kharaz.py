@@ -20,15 +20,21 @@ DEM benchmarks use for this pair (the digitized points do not give it). Planar c
 ``(vx, vy, omega)`` of the centre, x along the approach's tangential direction, y the anvil's
 normal, omega counterclockwise; the contact point lies at ``(0, -R)``, so friction spins the
 sphere clockwise and the rebound spin is stored negative.
+
+Geometry, for the engines (`Setup.geometry`): the sphere moves in the plane z = 0 (a planar
+joint), the anvil is the fixed plane y = 0, and the contact is at the origin, normal y,
+tangent x.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from lawbench.core.geometry import Body, ContactPair, Geometry, Joint
 from lawbench.measurements import impacts as measured
 
 NAME = "kharaz"
@@ -38,6 +44,9 @@ QUANTITIES = {
     "rebound_spin": ("incidence_spin", "spin"),
     "rebound_angle": ("incidence_angle", "rebound_angle"),
 }
+# The unit quaternion (w, x, y, z) of a quarter turn about -x: it takes the anvil plane's own
+# normal, its body's z axis, onto the world's y.
+ANVIL_TURN = (math.sqrt(0.5), -math.sqrt(0.5), 0.0, 0.0)
 # The normal restitution of alumina on glass that DEM benchmarks use for this experiment.
 NORMAL_RESTITUTION = 0.98
 SOURCE = measured.Source(
@@ -114,6 +123,21 @@ class Setup:
         angle = math.radians(incidence)
         return np.array([self.speed * math.sin(angle), -self.speed * math.cos(angle), 0.0])
 
+    def geometry(self, e: float = 0.0, mu: float = 0.0) -> Geometry:
+        """The sphere touching the anvil at the origin, the contact of coefficients e and mu.
+
+        ``to_bodies`` picks ``(vx, vy, omega)`` from the sphere's velocity ``(v, w)``.
+        """
+        sphere = Body(
+            "sphere", "sphere", (self.radius,), self.mass, (self.inertia,) * 3, (0, self.radius, 0)
+        )
+        anvil = Body("anvil", "plane", (), quaternion=ANVIL_TURN)
+        pair = ContactPair("sphere", "anvil", (0, 0, 0), (0, 1, 0), ((1, 0, 0),), e, mu)
+        joints = (Joint("planar", "sphere", (0, 0, 1)), Joint("fixed", "anvil"))
+        to_bodies = np.zeros((12, 3))
+        to_bodies[[0, 1, 5], [0, 1, 2]] = 1.0
+        return Geometry((sphere, anvil), joints, (pair,), to_bodies, to_bodies.T)
+
     def impact(
         self, incidence: float, restitution: float, spin: float, index: int
     ) -> measured.MeasuredImpact:
@@ -128,6 +152,7 @@ class Setup:
         normal = np.array([0.0, 1.0, 0.0])
         tangent = np.array([1.0, 0.0, self.radius])
         problem = measured.planar_problem(self.mass_matrix(), normal, tangent, v)
+        problem = dataclasses.replace(problem, geometry=self.geometry())
         facts = {"incidence_deg": incidence, "normal_restitution": NORMAL_RESTITUTION}
         return measured.MeasuredImpact(problem, after, None, NAME, index, facts)
 

@@ -438,11 +438,19 @@ def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
         if quick
         else f"on a grid of {len(kharaz_curves.GRID)} incidences and at the digitized ones"
     )
+    engines = [name for name in curves["law"].unique() if LAWS.get(name).engine]
+    stepped = (
+        f" The engines ({', '.join(engines)}) step the sphere on the anvil at their default "
+        "settings, what a user gets: each one's findings at settings = default (the laws "
+        "section) say why its curve departs."
+        if engines
+        else ""
+    )
     figure = Figure(
         "kharaz_curves",
         "Kharaz, Gorham and Salman's alumina sphere on glass at 3.9 m/s: every law that treats "
         f"one frictional planar contact, solved {where} with the benchmarks' e and mu (Hertz's "
-        "stiffness where a law reads one), over the measured points (black).",
+        f"stiffness where a law reads one), over the measured points (black).{stepped}",
         fig,
         curves,
     )
