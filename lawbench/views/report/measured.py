@@ -425,10 +425,12 @@ def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
     """
     fig, axes = plots.figure(2, 2, width=4.6, height=3.4)
     points = kharaz_curves.measured()
+    engines = [name for name in curves["law"].unique() if LAWS.get(name).engine]
     for ax, quantity in zip(axes.flat, kharaz_curves.QUANTITIES, strict=True):
         for law, rows in curves.groupby("law", sort=False):
-            style = plots.law_style(law)
-            ax.plot(rows["incidence"], rows[quantity], color=style["color"], label=law, lw=1)
+            color, dashed = plots.law_style(law)["color"], law in engines
+            line = "--" if dashed else "-"
+            ax.plot(rows["incidence"], rows[quantity], color=color, ls=line, label=law, lw=1)
         at, values = points[quantity]
         ax.scatter(at, values, color="k", s=14, zorder=3, label="Kharaz et al. 2001")
         ax.set_xlabel("incidence from the normal [deg]")
@@ -438,11 +440,10 @@ def kharaz_blocks(curves: pd.DataFrame, quick: bool) -> list[Block]:
         if quick
         else f"on a grid of {len(kharaz_curves.GRID)} incidences and at the digitized ones"
     )
-    engines = [name for name in curves["law"].unique() if LAWS.get(name).engine]
     stepped = (
-        f" The engines ({', '.join(engines)}) step the sphere on the anvil at their default "
-        "settings, what a user gets: each one's findings at settings = default (the laws "
-        "section) say why its curve departs."
+        f" The engines ({', '.join(engines)}, dashed) step the sphere on the anvil at their "
+        "default settings, what a user gets: each one's findings at settings = default (the "
+        "laws section) say why its curve departs."
         if engines
         else ""
     )

@@ -180,7 +180,8 @@ def law_style(name: str) -> dict[str, Any]:
         names = []
     index = names.index(name) if name in names else len(names)
     return {
-        "color": colormaps["tab10"](index % 10),
+        # Twenty distinct colours: tab10's, then their lighter partners in tab20.
+        "color": colormaps["tab20"]((2 * index + index // 10) % 20),
         "marker": MARKERS[index % len(MARKERS)],
         "label": name,
     }
