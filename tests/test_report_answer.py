@@ -175,6 +175,20 @@ def test_a_tie_goes_to_the_loosest_tolerance_and_a_failing_cell_is_never_chosen(
     assert answer.choose(holding, costs.mul([30, 1, 9, 9]), 1e-6)["value"] == 1e-6
 
 
+def test_an_engine_at_its_defaults_is_shown_with_the_tightest_level_it_reaches():
+    """Only an engine's point at all its default options is shown; a law is never shown."""
+    points = pd.DataFrame(
+        {
+            "law": ["pybullet", "pybullet", "mujoco", "moreau"],
+            "model_error": [0.34, 1e-5, 3e-3, 1e-8],
+            "options": ['{"dt": 0.0}', '{"dt": 0.0001}', "{}", '{"tol": 1e-10}'],
+        }
+    )
+    shown = answer.at_defaults(points)
+    assert shown == "pybullet 0.34 (none within 0.01), mujoco 0.003 (within 0.01)"
+    assert answer.at_defaults(points.iloc[3:]) == "none"
+
+
 # In the browser: measured with the page's folds closed, then everything measured with them open.
 PROBE = """<script>window.addEventListener('load', async () => {
 const body = document.body, set = (k, v) => body.setAttribute('data-' + k, v);

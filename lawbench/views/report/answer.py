@@ -3,7 +3,8 @@
 A view of the speed/accuracy studies (`lawbench.views.report.tradeoff.points`). Per scene, the
 ground truth it declares, the law closest to it with its *model error*
 ``max |v+ - v_truth| / max |v-|`` (relative, the speed/accuracy section's definition), and the
-cheapest law whose model error is within each level of `LEVELS`, with its cost; per measured
+cheapest law whose model error is within each level of `LEVELS`, with its cost, and each engine's
+model error at its default settings (`at_defaults`); per measured
 set, the law closest to the measurements (`lawbench.views.report.measured.closest_law`).
 
 Only a cell whose verdict is *holds* or *law property* is recommended: a cell whose verdict is a
@@ -31,6 +32,7 @@ import pandas as pd
 
 from lawbench.bench.timing import duration
 from lawbench.core.case import Case
+from lawbench.core.law import LAWS
 from lawbench.core.trial import solve
 from lawbench.core.verdicts import Verdict
 
@@ -152,6 +154,27 @@ def choices(data: pd.DataFrame, costs: pd.Series) -> dict[str, str]:
     return {key: "none" if row is None else point_text(row) for key, row in found.items()}
 
 
+def at_defaults(data: pd.DataFrame) -> str:
+    """Each engine's model error at its default options, and the tightest level it is within.
+
+    An engine (`Law.engine`) runs in the speed/accuracy study at its default settings, what a
+    user gets; its point whose options are all the law's defaults is the one shown.
+    """
+    shown = []
+    for _, row in data[data["model_error"].notna()].iterrows():
+        law = LAWS.get(row["law"]) if row["law"] in LAWS.names() else None
+        if law is None or not law.engine:
+            continue
+        defaults = law.option_values()
+        if any(defaults.get(k) != v for k, v in json.loads(row["options"]).items()):
+            continue
+        error = float(row["model_error"])
+        within = [level for level in LEVELS if error <= level]
+        reached = f"within {min(within):g}" if within else f"none within {max(LEVELS):g}"
+        shown.append(f"{row['law']} {error:.2g} ({reached})")
+    return ", ".join(shown) or "none"
+
+
 def scene_row(case: Case, data: pd.DataFrame, costs: pd.Series, anchor: str) -> dict[str, Any]:
     """The answer's row of one scene: truth, closest law, cheapest per level, set-aside cells."""
     truth = case.ground_truth
@@ -167,6 +190,7 @@ def scene_row(case: Case, data: pd.DataFrame, costs: pd.Series, anchor: str) -> 
         row[f"cheapest with model error ≤ {level:g}"] = (
             "none" if chosen is None else f"{point_text(chosen)}, {duration(costs[chosen.name])}"
         )
+    row["engines at their defaults, model error"] = at_defaults(data)
     aside = set_aside(data)
     row["set aside"] = ", ".join(
         f"[{point_text(r)}](#{cell_anchor(r['reproducer'])}): {r['verdict']}"
@@ -186,7 +210,8 @@ def caption(aside: int, levels: Sequence[float] = LEVELS) -> str:
         f"{RETIME_S:g} s in its study: that one solve). Of one law's tolerances or time steps "
         "that reach a level, only the loosest competes. Costs within {TIE:g}x of the "
         "cheapest are a tie, broken by the loosest tolerance (a law without a knob first), "
-        "then the law's name. Only cells that hold "
+        "then the law's name. An engine at its default settings (what a user gets) is shown "
+        "with its model error and the tightest level it reaches. Only cells that hold "
         f"(verdict holds or law property) are recommended: {aside} cells were set aside "
         "(numerical failure, budget or unexplained), each linked to its line in the health "
         "of the run."
