@@ -3,7 +3,8 @@
 Generalized coordinates: the velocity of the ball's centre (vx, vy, vz, m/s) and its angular
 velocity (wx, wy, wz, rad/s), both in the world frame: x and y along the table, z up, right-hand
 rule for the spin. The ball (solid, uniform: inertia ``2/5 m r^2``) touches the table at
-``(0, 0, -r)`` from its centre; one spatial contact, normal z, tangents x and y.
+``(0, 0, -r)`` from its centre; one spatial contact, normal z, tangents x and y. Geometry, for
+the engines: the ball on a free joint, the table the fixed plane z = 0.
 
 Parameters (defaults are the talk's values): ``velocity`` (1, 0, -5) m/s and
 ``angular_velocity`` (0, 2, 0) rad/s before the impact; ``radius`` 1 m; ``mass`` 1 kg; ``e`` 0.5
@@ -29,13 +30,16 @@ one unit below the talk's 1.92746. The analytic reference below is the frictionl
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
+from lawbench.cases._geometry import geometry, plane, solid_sphere
 from lawbench.core.case import CASES, Case, Params, Reference, exactly
+from lawbench.core.geometry import ContactPair, Geometry, Joint
 from lawbench.core.problem import MINDLIN_RATIO, Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
@@ -57,6 +61,7 @@ def body_on_table(
     angular_velocity: np.ndarray,
     params: Params,
     name: str,
+    geometry: Geometry | None = None,
 ) -> ImpactProblem:
     """A rigid body touching the table z = 0 at one point: the spatial impact problem.
 
@@ -74,6 +79,8 @@ def body_on_table(
         With ``e``, ``mu`` and ``tangential_stiffness_ratio``.
     name : str
         The body's name.
+    geometry : Geometry or None
+        What the body and the table look like, for the engines.
     """
     Wn = spatial_column(contact, np.array([0.0, 0.0, 1.0]))[:, None]
     Wt = np.column_stack([spatial_column(contact, t) for t in np.eye(3)[:2]])
@@ -93,7 +100,21 @@ def body_on_table(
             )
         ],
         bodies={name: range(6)},
+        geometry=geometry,
     )
+
+
+@functools.lru_cache(maxsize=64)
+def _geometry(mass: float, radius: float, e: float, mu: float) -> Geometry:
+    """The ball on a free joint, touching the table z = 0 at the origin.
+
+    Cached: a geometry is immutable, and a sweep of the velocities keeps it.
+    """
+    ball = solid_sphere("ball", mass, radius, (0.0, 0.0, radius))
+    table = plane("table", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    contact = ContactPair("ball", "table", (0, 0, 0), (0, 0, 1), ((1, 0, 0), (0, 1, 0)), e, mu)
+    joints = [Joint("free", "ball"), Joint("fixed", "table")]
+    return geometry([ball, table], joints, [contact], [(0, k) for k in range(6)])
 
 
 def contact_point_momentum(contact: np.ndarray) -> np.ndarray:
@@ -183,6 +204,7 @@ class BouncingBall(Case):
             np.asarray(params["angular_velocity"]),
             params,
             "ball",
+            _geometry(mass, radius, params["e"], params["mu"]),
         )
 
     def coordinates(self, params: Params) -> list[str]:

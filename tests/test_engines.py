@@ -46,6 +46,8 @@ SCENES = [
     ("sphere_wall", {}),
     ("rocking_block", {}),
     ("rocking_block", {"width": 2.0, "height": 1.0}),
+    ("bouncing_ball", {}),
+    ("bouncing_ball", {"angular_velocity": [6.0, 6.0, 0.0], "radius": 0.2}),
 ]
 
 
