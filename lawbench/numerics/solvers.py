@@ -421,7 +421,23 @@ def solve_lcp(
         return _nnls_lcp(as_array(G), q)
     identity = scipy.sparse.identity(len(q), format="csc") if is_sparse(G) else np.eye(len(q))
     result = clarabel_qp(G, q, identity, tol)
-    return _finish(G, q, result.x, result, refine)
+    return _finish(G, q, result.x, result, refine, tol)
+
+
+def _lcp_violation(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
+    """How far ``z >= 0`` is from solving ``0 <= G z + q _|_ z``, over the LCP's own scales.
+
+    The larger of a negative slack ``w = G z + q`` and a slack left open where ``z`` pushes,
+    over the contact velocities ``max |q|`` (and the impulses ``max z``); the rounding of the
+    slacks, sums of terms ``G_ij z_j`` that cancel, is allowed.
+    """
+    w = G @ z + q
+    rounding = ROUNDING * np.asarray(abs(G) @ z).ravel()
+    velocity = max(float(np.abs(q).max(initial=0.0)), ROUNDING)
+    impulse = max(float(z.max(initial=0.0)), ROUNDING)
+    below = float(np.max(-(w + rounding), initial=0.0)) / velocity
+    opened = np.maximum(w - rounding, 0.0) * z / impulse
+    return max(below, float(opened.max(initial=0.0)) / velocity)
 
 
 def _nnls_lcp(G: np.ndarray, q: np.ndarray) -> LCPResult:
@@ -451,18 +467,22 @@ def project_on_cone(
     its multipliers solve the LCP with matrix ``G = Wn.T M^-1 Wn`` and ``q = Wn.T v``.
     """
     result = clarabel_qp(M, -(M @ v), Wn.T, tol)
-    return _finish(G, Wn.T @ v, result.y, result, refine)
+    return _finish(G, Wn.T @ v, result.y, result, refine, tol)
 
 
 def _finish(
-    G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool
+    G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool, tol: float
 ) -> LCPResult:
     """Polish clarabel's answer; a status other than 'Solved' is accepted only when polished.
 
     An infeasibility certificate is never polished: the LCP then has no solution (its QP is
     unbounded, as where two closed contacts push along opposite normals and the restitution
     of one asks the other to approach), and clarabel's last iterate, impulses of 1e15 whose
-    slacks cancel within their rounding, would pass for one.
+    slacks cancel within their rounding, would pass for one. An answer left unpolished must
+    still solve the LCP to ``sqrt(tol)`` of its own scales (`_lcp_violation`): clarabel's
+    tolerances are relative to the QP's objective, and a velocity QP whose mass matrix holds a
+    stiff coordinate no contact moves (a condition of 1e9 and more) is 'Solved' with
+    multipliers whose slacks, on the contacts, are of the size of the approach itself.
     """
     if result.status in NO_SOLUTION:
         raise SolverFailure(
@@ -477,6 +497,14 @@ def _finish(
         current_budget().out_of_time()
     elif result.status != "Solved":
         raise SolverFailure(f"clarabel status {result.status} after {result.iterations} iterations")
+    else:
+        violation = _lcp_violation(G, q, z)
+        if not violation <= tol**0.5:
+            raise SolverFailure(
+                f"clarabel status Solved after {result.iterations} iterations, but its "
+                f"impulses break the LCP by {violation:.3g} of the contact velocities (beyond "
+                f"sqrt(tol) = {tol**0.5:.3g}): the problem is too ill-conditioned for its QP"
+            )
     return LCPResult(
         z, G @ z + q, "LCP (clarabel)", result.status, result.iterations, exact is not None
     )

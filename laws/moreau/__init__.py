@@ -126,7 +126,7 @@ import numpy as np
 
 from lawbench.checks.regions import option, separating_contact
 from lawbench.core.contact import ContactProblem
-from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law, current_budget
 from lawbench.core.metric import as_array
 from lawbench.core.outcome import Outcome
@@ -159,7 +159,13 @@ from lawbench.numerics.gauss_seidel import (
     one_contact,
     solve_polished,
 )
-from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
+from lawbench.numerics.solvers import (
+    ENUMERATION_MAX,
+    LCPResult,
+    enumerate_lcp,
+    project_on_cone,
+    solve_lcp,
+)
 
 if TYPE_CHECKING:
     from lawbench.core.batch import ProblemBatch
@@ -283,15 +289,8 @@ class Moreau(Law):
             return _resolve_friction(problem, e * restituted, options)
         large = problem.m > ENUMERATION_MAX
         single_e = large and (e == e[0]).all() and np.array_equal(restituted, un)
-        if single_e and large and not problem.decoupled:
-            plastic = project_on_cone(
-                problem.M,
-                problem.v,
-                problem.Wn,
-                problem.delassus,
-                options["tol"],
-                options["polish"],
-            )
+        plastic = _projected(problem, options) if single_e and not problem.decoupled else None
+        if plastic is not None:
             result, Pn = plastic, (1.0 + e[0]) * plastic.z
             formulation = "cone projection (clarabel)"
         else:
@@ -358,6 +357,30 @@ class Moreau(Law):
         if not found.all():
             return None
         return Pn, "LCP (active-set enumeration, batch)"
+
+
+def _projected(problem: ImpactProblem, options: dict[str, Any]) -> LCPResult | None:
+    """The plastic impact as a projection on the cone of admissible velocities, or None.
+
+    None where clarabel's velocity QP fails for want of precision: a mass matrix with a stiff
+    coordinate the contacts do not move (condition 1e9 and more) leaves its multipliers off by
+    the contacts' own velocities, and the LCP on the Delassus matrix, which holds the contacts'
+    coordinates only, is the well-conditioned form of the same law (an LCP without a solution
+    fails there too, saying so). A spent budget stops the solve.
+    """
+    try:
+        return project_on_cone(
+            problem.M,
+            problem.v,
+            problem.Wn,
+            problem.delassus,
+            options["tol"],
+            options["polish"],
+        )
+    except BudgetExceeded:
+        raise
+    except SolverFailure:
+        return None
 
 
 UNDAMPED = 20
