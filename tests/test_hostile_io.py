@@ -179,6 +179,25 @@ def test_run_files_refuse_a_negative_seed_a_fractional_count_and_bad_sizes():
         RunSpec.from_dict({"grid": grid, "sizes": [1]})
 
 
+@pytest.mark.parametrize(
+    ("entry", "message"),
+    [
+        ({"params": {"e": {"random": [0, 1, 2], "log": "yes"}}}, r"params\.e\.log: must be true"),
+        ({"params": {"e": {"random": [0, 1, 2], "sizes": 3}}}, "unknown key 'sizes'"),
+        ({"params": {"e": {"range": [0, 1, 2], "logrange": [0, 1, 2]}}}, "unknown key 'logrange'"),
+        ({"transforms": ["grazing=nan"]}, "'nan' is not a positive, finite speed"),
+        ({"transforms": ["duplicated=-1"]}, "'-1' is not a contact's number"),
+    ],
+    ids=["log not a bool", "unknown generator key", "two generators", "nan speed", "contact -1"],
+)
+def test_run_files_refuse_a_bad_generator_or_transform_naming_it(entry, message):
+    """Each was taken: ``log = "yes"`` drew logarithmically, ``sizes`` was ignored, the second
+    generator was dropped, and the transforms failed row by row as 'unexplained' cells."""
+    grid = {"laws": ["newton"], "cases": ["three_ball_chain"], **entry}
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        RunSpec.from_dict({"grid": [grid]}).rows()
+
+
 RUN = ["run", "--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial", "--quiet"]
 
 
