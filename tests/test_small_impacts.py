@@ -226,3 +226,19 @@ def test_a_solved_status_with_multipliers_that_break_the_lcp_fails():
         else:
             with pytest.raises(lawbench.SolverFailure, match="break the LCP"):
                 _finish(G, q, z, solved, False, 1e-10)
+
+
+def test_a_set_whose_slacks_are_rounding_is_no_solution_of_the_lcp():
+    """Contacts 0 and 2 along n separate, contact 1 along -0.83 n approaches and is restituted:
+    the three ask n.v+ to be both >= 0 and < 0, and the LCP has no solution. The enumeration
+    took a near-singular active set whose impulses of 3e15 leave slacks that are only their
+    rounding, and so did the polish of clarabel's answer: status ok, contact 0 approaching at
+    0.16 m/s."""
+    n, t = np.array([0.4776, -0.6055]), np.array([0.3, 0.7])
+    Wn = np.column_stack([n, -0.83 * n, 0.37 * n, t])
+    problem = ImpactProblem.from_arrays(np.eye(2), Wn, [0.8311, -0.2518], e=0.5)
+    with pytest.raises(lawbench.SolverFailure, match=r"no solution|break the LCP"):
+        lawbench.solve("moreau", problem)
+    q = problem.un + 0.5 * problem.un.clip(max=0.0)
+    assert not enumerate_lcp(problem.delassus, q)[1]
+    assert not enumerate_lcp(problem.delassus, q[None])[1].any()
