@@ -142,6 +142,7 @@ from lawbench.laws._claims import (
     keeps_energy,
     separating_held,
 )
+from lawbench.laws.moreau.answers import refuse_cancelling, refuse_outside_cones
 from lawbench.laws.moreau.methods import (
     FIXED_POINT_MAX,
     FIXED_POINT_STEPS,
@@ -410,26 +411,9 @@ def _resolve_friction(
     if _approaching(G @ P + q, m, options["tol"], scale):
         P = _one_contact_or_refuse(G, q, mu)
         diagnostics["formulation"] += ", then the contact's exact state"
-    _refuse_cancelling(G, P, options["tol"], scale)
+    refuse_cancelling(G, P, options["tol"], scale)
+    refuse_outside_cones(P, mu, d, options["tol"])
     return Outcome.from_impulses(problem, P[:m], P[m:], diagnostics=diagnostics)
-
-
-def _refuse_cancelling(G: Any, P: np.ndarray, tol: float, scale: float) -> None:
-    """Refuse impulses whose contributions to the local velocities cancel beyond precision.
-
-    Where the contact directions depend on each other (a singular contact Delassus matrix, a
-    body with fewer coordinates than its contact has directions) Coulomb's states have
-    impulses of any size along the dependence, and the exact state's slip formula gives ones
-    of 1e12 or more whose velocities are their rounding: an answer that left the contact
-    approaching, or dissipated nothing at e < 1, with an FC3D error of 1e-16.
-    """
-    rounding = np.finfo(float).eps * float(np.max(abs(G) @ np.abs(P)))
-    if rounding > tol**0.5 * scale:
-        raise SolverFailure(
-            f"moreau: impulses up to {np.abs(P).max():.3g} change the local velocities (of "
-            f"size {scale:.3g}) only through their cancellation, to within {rounding:.3g}: "
-            "the contact directions depend on each other"
-        )
 
 
 def _approaching(u: np.ndarray, m: int, tol: float, scale: float) -> bool:
