@@ -142,3 +142,43 @@ def test_a_library_that_cannot_be_mapped_at_start_is_one_line_and_exit_4(monkeyp
     err = capsys.readouterr().err
     assert err.startswith("lawbench: out of memory while starting (ImportError: libopenblas.so")
     assert len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("kib", [330_000, 400_000, 440_000])
+def test_an_address_space_too_small_to_solve_is_one_line_and_exit_4(kib):
+    """Room to start is not room to solve: numba's compiler and the BLAS buffers of the first
+    products map more. Under 320 to 520 MB a solve ended with OpenBLAS's exit(1), a hang, an
+    interrupt (OpenBLAS raising SIGINT), LLVM's or glibc's abort, or llvmlite's OSError read as
+    the standard output's ('lawbench: the output: ...', exit 2)."""
+    done = subprocess.run(
+        [
+            "bash",
+            "-c",
+            f"ulimit -v {kib}; exec {sys.executable} -m lawbench solve moreau sphere_wall",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, "OPENBLAS_NUM_THREADS": "1"},
+    )
+    assert done.returncode == 4, done.stderr[-1000:]
+    assert done.stderr.startswith("lawbench: out of memory")
+    assert len(done.stderr.splitlines()) == 1 and done.stdout == ""
+
+
+def test_a_library_that_cannot_be_mapped_mid_command_is_one_line_and_exit_4(monkeypatch, capsys):
+    from lawbench.views.cli import listing
+
+    def unmappable(args):
+        try:
+            raise OSError("libllvmlite.so: failed to map segment from shared object")
+        except OSError as exc:
+            raise OSError("Could not find/load shared object file 'libllvmlite.so'") from exc
+
+    monkeypatch.setattr(listing, "run", unmappable)
+    assert main(["list"]) == 4
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("lawbench: out of memory while loading a library")
+        and len(err.splitlines()) == 1
+    )

@@ -38,14 +38,14 @@ def _matrix(group, A, shape=None):
     group.create_dataset("x", data=A[rows, columns])
 
 
-def local_file(path, W=None, mu=0.3, *, spacedim=3, mu_as_group=False, shape=None):
+def local_file(path, W=None, mu=0.3, *, spacedim=3, mu_as_group=False, shape=None, q=Q):
     """An FCLIB local form; each keyword makes one field hostile."""
     with h5py.File(path, "w") as handle:
         root = handle.create_group("fclib_local")
         root.create_dataset("spacedim", data=np.array(spacedim, dtype=np.int32).ravel())
         _matrix(root.create_group("W"), np.eye(3) if W is None else np.asarray(W), shape)
         vectors = root.create_group("vectors")
-        vectors.create_dataset("q", data=Q)
+        vectors.create_dataset("q", data=q)
         if mu_as_group:
             vectors.create_group("mu")
         else:
@@ -53,12 +53,12 @@ def local_file(path, W=None, mu=0.3, *, spacedim=3, mu_as_group=False, shape=Non
     return path
 
 
-def global_file(path, f_size):
+def global_file(path, f_size, n=6):
     with h5py.File(path, "w") as handle:
         root = handle.create_group("fclib_global")
         root.create_dataset("spacedim", data=np.array([3], dtype=np.int32))
-        _matrix(root.create_group("M"), np.eye(6))
-        _matrix(root.create_group("H"), np.eye(6)[:, :3])
+        _matrix(root.create_group("M"), np.eye(n))
+        _matrix(root.create_group("H"), np.eye(n, 3))
         vectors = root.create_group("vectors")
         vectors.create_dataset("f", data=np.ones(f_size))
         vectors.create_dataset("w", data=np.zeros(3))
@@ -82,6 +82,7 @@ HOSTILE = {
     "mu a group": (lambda p: local_file(p, mu_as_group=True), "mu is a group"),
     "f shorter than M": (lambda p: global_file(p, 4), "M is 6 x 6 where the 4 entries of f"),
     "a billion rows": (lambda p: local_file(p, shape=(10**9, 10**9)), "W is 1000000000 x"),
+    "no coordinates": (lambda p: global_file(p, 0, n=0), "f holds no entry"),
 }
 
 
@@ -105,6 +106,23 @@ def test_a_tiny_delassus_matrix_is_solved_with_a_finite_error(tmp_path, capsys, 
     answer = json.loads(out)
     assert answer["fc3d_error"] <= 1e-10
     assert answer["r"][0] == pytest.approx(1e300, rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("W", "q"),
+    [(1e-320 * np.eye(3), Q), (np.eye(3), [-1e308, 3e307, 1e307])],
+    ids=["subnormal W", "huge q"],
+)
+@pytest.mark.parametrize("method", ["nsgs", "auto"])
+def test_a_sweep_beyond_double_precision_fails_or_answers_right(tmp_path, capsys, W, q, method):
+    """A block of W of 1e-320 has no finite inverse, and q of 1e308 overflows the sweep's
+    local solves: numba's LinAlgError ended the command as an internal error, exit 1."""
+    path = local_file(tmp_path / "w.h5", W, q=q)
+    argv = ["solve", "moreau", "--problem", path, "--option", f"method={method}", "--json"]
+    code, out, err = run_cli(argv, capsys)
+    assert code in (0, 4) and (code == 0 or one_line(err)), err
+    if code == 0:
+        assert json.loads(out)["fc3d_error"] <= 1e-10
 
 
 INDEFINITE = [[1.0, 2.0, 0.0], [2.0, -1.0, 0.5], [0.0, 0.5, 1.0]]
@@ -159,6 +177,25 @@ def test_run_files_refuse_a_negative_seed_a_fractional_count_and_bad_sizes():
         RunSpec.from_dict({"grid": [{**grid[0], "params": {"e": {"range": [0, 1, 2.5]}}}]})
     with pytest.raises(lawbench.InvalidProblem, match="unknown key 'sizes'"):
         RunSpec.from_dict({"grid": grid, "sizes": [1]})
+
+
+@pytest.mark.parametrize(
+    ("entry", "message"),
+    [
+        ({"params": {"e": {"random": [0, 1, 2], "log": "yes"}}}, r"params\.e\.log: must be true"),
+        ({"params": {"e": {"random": [0, 1, 2], "sizes": 3}}}, "unknown key 'sizes'"),
+        ({"params": {"e": {"range": [0, 1, 2], "logrange": [0, 1, 2]}}}, "unknown key 'logrange'"),
+        ({"transforms": ["grazing=nan"]}, "'nan' is not a positive, finite speed"),
+        ({"transforms": ["duplicated=-1"]}, "'-1' is not a contact's number"),
+    ],
+    ids=["log not a bool", "unknown generator key", "two generators", "nan speed", "contact -1"],
+)
+def test_run_files_refuse_a_bad_generator_or_transform_naming_it(entry, message):
+    """Each was taken: ``log = "yes"`` drew logarithmically, ``sizes`` was ignored, the second
+    generator was dropped, and the transforms failed row by row as 'unexplained' cells."""
+    grid = {"laws": ["newton"], "cases": ["three_ball_chain"], **entry}
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        RunSpec.from_dict({"grid": [grid]}).rows()
 
 
 RUN = ["run", "--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial", "--quiet"]

@@ -449,3 +449,23 @@ def test_impulses_that_change_the_velocities_only_through_their_rounding_are_ref
     )
     with pytest.raises(lawbench.SolverFailure, match="only through their cancellation"):
         lawbench.solve("moreau", problem)
+
+
+def test_a_cone_narrower_than_the_solvers_tolerances_is_never_left_ok():
+    """At mu = 1e-9 (not yet negligible) the cone QP's cone (mu Pn, Pt) lies below clarabel's
+    tolerances, and the polish, kept for lowering the natural residual, made contact 0 stick
+    with |Pt| = 0.5 where mu Pn is 5e-10: status ok. The answer keeps its cones or fails."""
+    problem = lawbench.ImpactProblem.from_arrays(
+        np.diag([1.33, 1.95, 1.72]),
+        [[0.68, -0.38, 0.23], [1.14, -0.06, -2.54], [0.68, 1.08, -0.95]],
+        [-0.34, -1.06, 1.45],
+        [[-0.35, -0.02, 0.29], [0.14, -1.38, -1.75], [0.08, 1.28, 2.51]],
+        e=0.5,
+        mu=1e-9,
+    )
+    try:
+        outcome = lawbench.solve("moreau", problem)
+    except lawbench.SolverFailure as failure:
+        assert "leaves its Coulomb cone" in str(failure)
+        return
+    assert (np.abs(outcome.Pt) <= 1e-9 * outcome.Pn + 1e-12).all(), (outcome.Pn, outcome.Pt)

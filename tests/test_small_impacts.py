@@ -15,7 +15,15 @@ import pytest
 import lawbench
 from lawbench import Contact, ImpactProblem, InvalidProblem
 from lawbench.core.metric import KineticMetric
-from lawbench.numerics.solvers import _enumerate_sets, clarabel_qp, enumerate_lcp, polish, solve_lcp
+from lawbench.numerics.solvers import (
+    QPResult,
+    _enumerate_sets,
+    _finish,
+    clarabel_qp,
+    enumerate_lcp,
+    polish,
+    solve_lcp,
+)
 
 
 def random_lcps(rng, count, m, decades=2.0):
@@ -183,3 +191,54 @@ def test_an_lcp_without_a_solution_is_never_polished_into_one():
     q = problem.un + problem.un.clip(max=0.0)
     with pytest.raises(lawbench.SolverFailure, match="DualInfeasible"):
         solve_lcp(problem.delassus, q)
+
+
+# Seven contacts (beyond the enumeration) along three directions of the plane of the first
+# two coordinates, every one of them approaching; the third coordinate, which no contact
+# moves, is STIFF times heavier.
+REDUNDANT = np.array([[1, 0, 1, 0, 1, 1, 0], [0, 1, 0, 2, 1, 0, 1], [0, 0, 0, 0, 0, 0, 0]])
+
+
+@pytest.mark.parametrize("stiff", [3e9, 1e12])
+def test_a_stiff_coordinate_no_contact_moves_leaves_moreaus_answer_exact(stiff):
+    """The plane's velocity (-1, -1) approaches every contact, so its projection on their cone
+    is 0 and Moreau's law (e = 0.5) gives (0.5, 0.5), the third coordinate untouched. clarabel's
+    velocity QP, whose tolerances are relative to the stiff coordinate's kinetic energy, ended
+    'Solved' with multipliers that broke the LCP by a third of the approach: status ok, with
+    (0.47, 0.04) at 3e9 and an energy gain at 1e12. An unpolished answer is now held to the
+    LCP, and the law solves the Delassus LCP, which does not see the stiff coordinate."""
+    problem = ImpactProblem.from_arrays(np.diag([1.0, 1.0, stiff]), REDUNDANT, [-1, -1, 1], e=0.5)
+    try:
+        outcome = lawbench.solve("moreau", problem)
+    except lawbench.SolverFailure as failure:
+        assert "break the LCP" in str(failure)
+        return
+    np.testing.assert_allclose(outcome.v_plus, [0.5, 0.5, 1.0], rtol=1e-5)
+
+
+def test_a_solved_status_with_multipliers_that_break_the_lcp_fails():
+    G, q = np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([-1.0, -1.0])
+    for z, holds in (([0.5, 0.5], True), ([0.2, 0.2], False), ([2.0, 0.0], False)):
+        z = np.array(z)
+        solved = QPResult(z, z, "Solved", 5)
+        if holds:
+            assert _finish(G, q, z, solved, False, 1e-10).z.tolist() == z.tolist()
+        else:
+            with pytest.raises(lawbench.SolverFailure, match="break the LCP"):
+                _finish(G, q, z, solved, False, 1e-10)
+
+
+def test_a_set_whose_slacks_are_rounding_is_no_solution_of_the_lcp():
+    """Contacts 0 and 2 along n separate, contact 1 along -0.83 n approaches and is restituted:
+    the three ask n.v+ to be both >= 0 and < 0, and the LCP has no solution. The enumeration
+    took a near-singular active set whose impulses of 3e15 leave slacks that are only their
+    rounding, and so did the polish of clarabel's answer: status ok, contact 0 approaching at
+    0.16 m/s."""
+    n, t = np.array([0.4776, -0.6055]), np.array([0.3, 0.7])
+    Wn = np.column_stack([n, -0.83 * n, 0.37 * n, t])
+    problem = ImpactProblem.from_arrays(np.eye(2), Wn, [0.8311, -0.2518], e=0.5)
+    with pytest.raises(lawbench.SolverFailure, match=r"no solution|break the LCP"):
+        lawbench.solve("moreau", problem)
+    q = problem.un + 0.5 * problem.un.clip(max=0.0)
+    assert not enumerate_lcp(problem.delassus, q)[1]
+    assert not enumerate_lcp(problem.delassus, q[None])[1].any()

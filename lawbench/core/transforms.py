@@ -39,12 +39,18 @@ class Transform:
         ``(problem, value) -> problem``.
     default : float or None
         The value of ``NAME`` spelled alone; None when a value is required.
+    domain : str
+        The values it takes, as `parse` names them when refusing another.
+    accepts : callable
+        ``value -> bool``: whether ``value`` lies in ``domain``, whatever the problem.
     """
 
     name: str
     doc: str
     apply: Callable[[ImpactProblem, float], ImpactProblem]
     default: float | None = None
+    domain: str = "a finite number"
+    accepts: Callable[[float], bool] = math.isfinite
 
 
 def grazing(problem: ImpactProblem, speed: float) -> ImpactProblem:
@@ -87,8 +93,21 @@ def duplicated(problem: ImpactProblem, contact: float = 0) -> ImpactProblem:
 TRANSFORMS = {
     t.name: t
     for t in (
-        Transform("grazing", "fastest approach made SPEED (m/s), unseen motion kept", grazing),
-        Transform("duplicated", "contact J (default 0) given twice", duplicated, 0.0),
+        Transform(
+            "grazing",
+            "fastest approach made SPEED (m/s), unseen motion kept",
+            grazing,
+            domain="a positive, finite speed",
+            accepts=lambda speed: 0 < speed < math.inf,
+        ),
+        Transform(
+            "duplicated",
+            "contact J (default 0) given twice",
+            duplicated,
+            0.0,
+            domain="a contact's number (0, 1, ...)",
+            accepts=lambda j: 0 <= j < math.inf and j == int(j),
+        ),
     )
 }
 
@@ -99,7 +118,9 @@ def parse(spelling: str) -> tuple[Transform, float]:
     Raises
     ------
     InvalidProblem
-        For an unknown name or a value that is not a number.
+        For an unknown name, or a value that is not a number or lies outside the transform's
+        domain (a grazing speed of nan, a contact numbered 1.5), so that a run refuses it
+        before any work.
     """
     name, sep, text = spelling.partition("=")
     transform = TRANSFORMS.get(name.strip())
@@ -111,9 +132,12 @@ def parse(spelling: str) -> tuple[Transform, float]:
             raise InvalidProblem(f"transform {transform.name}: give a value ({transform.doc})")
         return transform, transform.default
     try:
-        return transform, float(text)
+        value = float(text)
     except ValueError:
         raise InvalidProblem(f"transform {spelling!r}: {text!r} is not a number") from None
+    if not transform.accepts(value):
+        raise InvalidProblem(f"transform {spelling!r}: {text!r} is not {transform.domain}")
+    return transform, value
 
 
 def spell(name: str, value: float | None = None) -> str:

@@ -333,6 +333,8 @@ def read_open(handle: Any, where: str) -> FclibRead:
         if "G" in root:
             raise InvalidProblem(f"{where}/G: equality constraints are not an impact problem")
         f = _vector(vectors, "f", at)
+        if not f.size:
+            raise InvalidProblem(f"{at}/f holds no entry: a global form needs coordinates")
         n, coordinates = f.size, f"the {f.size} entries of f"
         M, of_M = _read_matrix(_member(root, "M", where), f"{where}/M", (n, n), coordinates)
         H, of_H = _read_matrix(

@@ -469,7 +469,14 @@ def solve_nsgs(
     while True:
         spend.step("Gauss-Seidel sweeps", note)
         with _whole(fast):
-            change = _sweep(W.indptr, W.indices, W.data, blocks, inverse, local_q, mu, P)
+            try:
+                change = _sweep(W.indptr, W.indices, W.data, blocks, inverse, local_q, mu, P)
+            except np.linalg.LinAlgError:  # a block's inverse or an impulse overflowed
+                raise SolverFailure(
+                    f"Gauss-Seidel: sweep {sweeps + 1} met a number beyond double precision "
+                    f"(a contact's block of W too small to invert, or |q| up to "
+                    f"{float(np.abs(local_q).max()):.3g})"
+                ) from None
         sweeps += 1
         light = np.sqrt(change) / max(float(np.linalg.norm(P)), TINY)
         if light <= gate or sweeps % CHECK_EVERY == 0:

@@ -41,6 +41,12 @@ ENUMERATION_MAX = 6
 SPARSE_SIZE = 64
 # Relative violation of z >= 0 and w >= 0 accepted as rounding.
 COMPLEMENTARITY = 1e-10
+# Largest rounding of the slacks w = G z + q, eps max_i sum_j |G_ij z_j|, over the velocities
+# max |q|, of an active set's solution: beyond it the slacks are rounding, not velocities. An
+# LCP without a solution (opposite normals, one contact restituted) has on a near-singular set
+# impulses of 1e16 whose slacks cancel to anything, and the set passed for its solution.
+CANCELLING = 1e-5
+EPS = float(np.finfo(float).eps)
 # clarabel's certificates that a QP has no solution: for an LCP's QP, that the LCP has none.
 NO_SOLUTION = frozenset({"PrimalInfeasible", "DualInfeasible"})
 
@@ -131,9 +137,13 @@ def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarr
     slack = G @ exact + q
     velocity_scale = max(np.abs(q).max(), ROUNDING)
     impulse_scale = max(np.abs(exact).max(), ROUNDING)
-    # A slack is a sum of terms G_ij z_j that cancel down to the size of q: their rounding too.
-    rounding = ROUNDING * (abs(G) @ np.abs(exact))
+    # A slack is a sum of terms G_ij z_j that cancel down to the size of q: their rounding too,
+    # unless it is all the slack holds (`CANCELLING`).
+    reach = abs(G) @ np.abs(exact)
+    rounding = ROUNDING * reach
     if exact.min() < -1e-10 * impulse_scale or (slack < -1e-10 * velocity_scale - rounding).any():
+        return None
+    if EPS * float(reach.max()) > CANCELLING * velocity_scale:
         return None
     return np.maximum(exact, 0.0)
 
@@ -256,6 +266,8 @@ def _enumerate_batch(G: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarr
             for i in range(m):
                 terms = [g[i][j] * x for j, x in zip(active.tolist(), solved, strict=True)]
                 good &= sum(terms, start=0.0) + rhs[i] >= floor
+                reach = sum(map(np.abs, terms), start=0.0)
+                good &= EPS * reach <= -floor / COMPLEMENTARITY * CANCELLING
         for j, x in zip(active.tolist(), solved, strict=True):
             z[j] = np.where(good, np.maximum(x, 0.0), z[j])
         found |= good
@@ -326,7 +338,8 @@ def _two_contacts(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float
         ):
             continue
         w0, w1 = a * z0 + b * z1 + q0, c * z0 + d * z1 + q1
-        if w0 >= floor and w1 >= floor and math.isfinite(z0 + z1):
+        reach = max(abs(a * z0) + abs(b * z1), abs(c * z0) + abs(d * z1))
+        if w0 >= floor and w1 >= floor and math.isfinite(z0 + z1) and not _cancels(reach, floor):
             z0, z1 = max(z0, 0.0), max(z1, 0.0)
             return [z0, z1], [a * z0 + b * z1 + q0, c * z0 + d * z1 + q1]
     return None
@@ -364,10 +377,21 @@ def _enumerate_sets(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[flo
         impulse_scale = max(max(abs(x) for x in candidate), ROUNDING)
         if min(candidate) < -COMPLEMENTARITY * impulse_scale:
             continue
-        if min(_affine(rows, candidate, rhs)) >= floor:
+        if min(_affine(rows, candidate, rhs)) >= floor and not _cancels(
+            max(sum(abs(g * x) for g, x in zip(row, candidate, strict=True)) for row in rows),
+            floor,
+        ):
             z = [max(x, 0.0) for x in candidate]
             return z, _affine(rows, z, rhs)
     return None
+
+
+def _cancels(reach: float, floor: float) -> bool:
+    """Whether slacks summed from terms up to ``reach`` are rounding (`CANCELLING`).
+
+    ``floor`` is the enumeration's ``-COMPLEMENTARITY max |q|``.
+    """
+    return EPS * reach > -floor / COMPLEMENTARITY * CANCELLING
 
 
 def _affine(rows: list[list[float]], z: list[float], q: list[float]) -> list[float]:
@@ -421,7 +445,27 @@ def solve_lcp(
         return _nnls_lcp(as_array(G), q)
     identity = scipy.sparse.identity(len(q), format="csc") if is_sparse(G) else np.eye(len(q))
     result = clarabel_qp(G, q, identity, tol)
-    return _finish(G, q, result.x, result, refine)
+    return _finish(G, q, result.x, result, refine, tol)
+
+
+def _lcp_violation(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
+    """How far ``z >= 0`` is from solving ``0 <= G z + q _|_ z``, over the LCP's own scales.
+
+    The larger of a negative slack ``w = G z + q`` and a slack left open where ``z`` pushes,
+    over the contact velocities ``max |q|`` (and the impulses ``max z``); the rounding of the
+    slacks, sums of terms ``G_ij z_j`` that cancel, is allowed, unless it is all they hold
+    (infinite then).
+    """
+    w = G @ z + q
+    reach = np.asarray(abs(G) @ z).ravel()
+    rounding = ROUNDING * reach
+    velocity = max(float(np.abs(q).max(initial=0.0)), ROUNDING)
+    if EPS * float(reach.max(initial=0.0)) > CANCELLING * velocity:
+        return math.inf  # the slacks are the rounding of impulses that cancel (`CANCELLING`)
+    impulse = max(float(z.max(initial=0.0)), ROUNDING)
+    below = float(np.max(-(w + rounding), initial=0.0)) / velocity
+    opened = np.maximum(w - rounding, 0.0) * z / impulse
+    return max(below, float(opened.max(initial=0.0)) / velocity)
 
 
 def _nnls_lcp(G: np.ndarray, q: np.ndarray) -> LCPResult:
@@ -451,18 +495,22 @@ def project_on_cone(
     its multipliers solve the LCP with matrix ``G = Wn.T M^-1 Wn`` and ``q = Wn.T v``.
     """
     result = clarabel_qp(M, -(M @ v), Wn.T, tol)
-    return _finish(G, Wn.T @ v, result.y, result, refine)
+    return _finish(G, Wn.T @ v, result.y, result, refine, tol)
 
 
 def _finish(
-    G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool
+    G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool, tol: float
 ) -> LCPResult:
     """Polish clarabel's answer; a status other than 'Solved' is accepted only when polished.
 
     An infeasibility certificate is never polished: the LCP then has no solution (its QP is
     unbounded, as where two closed contacts push along opposite normals and the restitution
     of one asks the other to approach), and clarabel's last iterate, impulses of 1e15 whose
-    slacks cancel within their rounding, would pass for one.
+    slacks cancel within their rounding, would pass for one. An answer left unpolished must
+    still solve the LCP to ``sqrt(tol)`` of its own scales (`_lcp_violation`): clarabel's
+    tolerances are relative to the QP's objective, and a velocity QP whose mass matrix holds a
+    stiff coordinate no contact moves (a condition of 1e9 and more) is 'Solved' with
+    multipliers whose slacks, on the contacts, are of the size of the approach itself.
     """
     if result.status in NO_SOLUTION:
         raise SolverFailure(
@@ -477,6 +525,19 @@ def _finish(
         current_budget().out_of_time()
     elif result.status != "Solved":
         raise SolverFailure(f"clarabel status {result.status} after {result.iterations} iterations")
+    else:
+        violation = _lcp_violation(G, q, z)
+        if not violation <= tol**0.5:
+            by = (
+                f"by {violation:.3g} of the contact velocities (beyond sqrt(tol) = {tol**0.5:.3g})"
+                if math.isfinite(violation)
+                else f"with impulses up to {z.max():.3g} whose slacks are their rounding"
+            )
+            raise SolverFailure(
+                f"clarabel status Solved after {result.iterations} iterations, but its "
+                f"impulses break the LCP {by}: the problem is too ill-conditioned for its QP, "
+                "or the LCP has no solution"
+            )
     return LCPResult(
         z, G @ z + q, "LCP (clarabel)", result.status, result.iterations, exact is not None
     )

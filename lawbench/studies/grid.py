@@ -477,6 +477,17 @@ class Generated(Sequence[Any]):
         self.kind = next((kind for kind in self.KINDS if kind in spec), None)
         if self.kind is None:
             raise InvalidProblem(f"spec {_key(where)}: unknown value generator {dict(spec)}")
+        known = (self.kind, "log", "size") if self.kind == "random" else (self.kind,)
+        unknown = sorted(set(spec) - set(known))
+        if unknown:
+            raise InvalidProblem(
+                f"spec {_key(where)}: unknown key {unknown[0]!r} in value generator "
+                f"{dict(spec)}; known: {', '.join(known)}"
+            )
+        if not isinstance(spec.get("log", False), bool):
+            raise InvalidProblem(
+                f"spec {_key(where)}.log: must be true or false, got {spec['log']!r}"
+            )
         try:
             start, stop, count = spec[self.kind]
             self.start, self.stop = float(start), float(stop)
@@ -485,7 +496,7 @@ class Generated(Sequence[Any]):
             raise InvalidProblem(
                 f"spec {_key(where)}: bad value generator {dict(spec)} ({exc})"
             ) from None
-        self.log = bool(spec.get("log", False))
+        self.log = spec.get("log", False)
         problem = self._problem()
         if problem:
             raise InvalidProblem(

@@ -6,27 +6,17 @@ Under an address-space limit (``ulimit -v``) their start can fail in native code
 Python's reach: OpenBLAS, unable to map its buffers, loops without end, exits, or raises SIGINT
 (read by Python as the user's Ctrl-C), and a library that cannot be mapped is an ImportError
 with a traceback. So `program` first reserves, and gives back, the address space those
-libraries map as they load; where the limit leaves less, or a MemoryError or an unmappable
-library still stops the start, it says so in one line with a solver failure's exit code, 4:
-the work needs more memory than it was given.
+libraries map as they load (`lawbench.views.room`); where the limit leaves less, or a
+MemoryError or an unmappable library still stops the start, it says so in one line with a
+solver failure's exit code, 4: the work needs more memory than it was given.
 """
 
 from __future__ import annotations
 
-import errno
-import mmap
-import os
-import resource
 import sys
 
-# Address space the start maps beyond the interpreter's: a fixed part and, per BLAS thread, a
-# buffer and a stack in each of numpy's and scipy's OpenBLAS builds (measured on Linux x86-64
-# with numpy 2.4 and scipy 1.16: the peak of ``lawbench list`` is 148 MiB plus 80 MiB per
-# thread, the interpreter's 14 MiB included). OpenBLAS starts a thread per core, at most
-# MAX_THREADS (64 in both builds), or as many as OPENBLAS_NUM_THREADS or OMP_NUM_THREADS say.
-START_BYTES = 135 << 20
-BLAS_THREAD_BYTES = 80 << 20
-BLAS_THREADS_MAX = 64
+from lawbench.views.room import room_to_start, unmappable
+
 # The exit code of a solver failure, which running out of memory is (`lawbench.views.cli`).
 OUT_OF_MEMORY = 4
 # Exit code of an internal error: a library that cannot be imported for another reason.
@@ -35,7 +25,7 @@ INTERNAL = 1
 
 def program() -> int:
     """Run ``lawbench`` on this process's arguments, owning the process; return the exit code."""
-    short = _room_to_start()
+    short = room_to_start()
     if short:
         return _refuse(f"lawbench: out of memory: {short}", OUT_OF_MEMORY)
     try:
@@ -43,52 +33,10 @@ def program() -> int:
     except MemoryError:
         return _refuse("lawbench: out of memory while starting (MemoryError)", OUT_OF_MEMORY)
     except (ImportError, OSError) as exc:
-        if _unmappable(exc):
+        if unmappable(exc):
             return _refuse(f"lawbench: out of memory while starting ({_cause(exc)})", OUT_OF_MEMORY)
         return _refuse(f"lawbench: internal error: cannot start: {_cause(exc)}", INTERNAL)
     return main(own_process=True)
-
-
-def blas_threads() -> int:
-    """The threads OpenBLAS starts in this process (see `START_BYTES`)."""
-    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
-        value = os.environ.get(name, "").strip()
-        if value.isdigit() and int(value) > 0:
-            return min(int(value), BLAS_THREADS_MAX)
-    return min(len(os.sched_getaffinity(0)), BLAS_THREADS_MAX)
-
-
-def _room_to_start() -> str:
-    """Why the address space left is too small for the start, or '' when it is not.
-
-    Without a limit there is nothing to check. With one, the start's address space is mapped
-    (readable, never touched, so no memory is used) and unmapped at once.
-    """
-    limit = resource.getrlimit(resource.RLIMIT_AS)[0]
-    if limit == resource.RLIM_INFINITY:
-        return ""
-    need = START_BYTES + BLAS_THREAD_BYTES * blas_threads()
-    try:
-        flags = mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS
-        mmap.mmap(-1, need, flags=flags, prot=mmap.PROT_READ).close()
-    except (OSError, MemoryError):
-        return (
-            f"the address-space limit (ulimit -v, {limit >> 20} MiB) leaves less than the "
-            f"{need >> 20} MiB numpy and scipy map as they load"
-        )
-    return ""
-
-
-def _unmappable(exc: BaseException) -> bool:
-    """Whether ``exc`` (or an error that caused it) is a library that memory could not hold."""
-    while exc is not None:
-        if isinstance(exc, MemoryError) or getattr(exc, "errno", None) == errno.ENOMEM:
-            return True
-        text = str(exc).lower()
-        if "failed to map segment" in text or "cannot allocate memory" in text:
-            return True
-        exc = exc.__cause__ or exc.__context__
-    return False
 
 
 def _cause(exc: BaseException) -> str:

@@ -126,7 +126,7 @@ import numpy as np
 
 from lawbench.checks.regions import option, separating_contact
 from lawbench.core.contact import ContactProblem
-from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law, current_budget
 from lawbench.core.metric import as_array
 from lawbench.core.outcome import Outcome
@@ -142,6 +142,7 @@ from lawbench.laws._claims import (
     keeps_energy,
     separating_held,
 )
+from lawbench.laws.moreau.answers import refuse_cancelling, refuse_outside_cones
 from lawbench.laws.moreau.methods import (
     FIXED_POINT_MAX,
     FIXED_POINT_STEPS,
@@ -159,7 +160,13 @@ from lawbench.numerics.gauss_seidel import (
     one_contact,
     solve_polished,
 )
-from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp, project_on_cone, solve_lcp
+from lawbench.numerics.solvers import (
+    ENUMERATION_MAX,
+    LCPResult,
+    enumerate_lcp,
+    project_on_cone,
+    solve_lcp,
+)
 
 if TYPE_CHECKING:
     from lawbench.core.batch import ProblemBatch
@@ -283,15 +290,8 @@ class Moreau(Law):
             return _resolve_friction(problem, e * restituted, options)
         large = problem.m > ENUMERATION_MAX
         single_e = large and (e == e[0]).all() and np.array_equal(restituted, un)
-        if single_e and large and not problem.decoupled:
-            plastic = project_on_cone(
-                problem.M,
-                problem.v,
-                problem.Wn,
-                problem.delassus,
-                options["tol"],
-                options["polish"],
-            )
+        plastic = _projected(problem, options) if single_e and not problem.decoupled else None
+        if plastic is not None:
             result, Pn = plastic, (1.0 + e[0]) * plastic.z
             formulation = "cone projection (clarabel)"
         else:
@@ -360,6 +360,30 @@ class Moreau(Law):
         return Pn, "LCP (active-set enumeration, batch)"
 
 
+def _projected(problem: ImpactProblem, options: dict[str, Any]) -> LCPResult | None:
+    """The plastic impact as a projection on the cone of admissible velocities, or None.
+
+    None where clarabel's velocity QP fails for want of precision: a mass matrix with a stiff
+    coordinate the contacts do not move (condition 1e9 and more) leaves its multipliers off by
+    the contacts' own velocities, and the LCP on the Delassus matrix, which holds the contacts'
+    coordinates only, is the well-conditioned form of the same law (an LCP without a solution
+    fails there too, saying so). A spent budget stops the solve.
+    """
+    try:
+        return project_on_cone(
+            problem.M,
+            problem.v,
+            problem.Wn,
+            problem.delassus,
+            options["tol"],
+            options["polish"],
+        )
+    except BudgetExceeded:
+        raise
+    except SolverFailure:
+        return None
+
+
 UNDAMPED = 20
 # Relative tolerance of Coulomb's conditions on a mode's closed form at one contact.
 COULOMB_TOLERANCE = 1e-9
@@ -387,26 +411,9 @@ def _resolve_friction(
     if _approaching(G @ P + q, m, options["tol"], scale):
         P = _one_contact_or_refuse(G, q, mu)
         diagnostics["formulation"] += ", then the contact's exact state"
-    _refuse_cancelling(G, P, options["tol"], scale)
+    refuse_cancelling(G, P, options["tol"], scale)
+    refuse_outside_cones(P, mu, d, options["tol"])
     return Outcome.from_impulses(problem, P[:m], P[m:], diagnostics=diagnostics)
-
-
-def _refuse_cancelling(G: Any, P: np.ndarray, tol: float, scale: float) -> None:
-    """Refuse impulses whose contributions to the local velocities cancel beyond precision.
-
-    Where the contact directions depend on each other (a singular contact Delassus matrix, a
-    body with fewer coordinates than its contact has directions) Coulomb's states have
-    impulses of any size along the dependence, and the exact state's slip formula gives ones
-    of 1e12 or more whose velocities are their rounding: an answer that left the contact
-    approaching, or dissipated nothing at e < 1, with an FC3D error of 1e-16.
-    """
-    rounding = np.finfo(float).eps * float(np.max(abs(G) @ np.abs(P)))
-    if rounding > tol**0.5 * scale:
-        raise SolverFailure(
-            f"moreau: impulses up to {np.abs(P).max():.3g} change the local velocities (of "
-            f"size {scale:.3g}) only through their cancellation, to within {rounding:.3g}: "
-            "the contact directions depend on each other"
-        )
 
 
 def _approaching(u: np.ndarray, m: int, tol: float, scale: float) -> bool:

@@ -27,6 +27,7 @@ from lawbench.core.guards import end_process_when_stuck, watch_interrupts
 from lawbench.core.registry import Registry
 from lawbench.files.paths import NO_ROOM
 from lawbench.studies.guard import BUDGET_S, EXECUTORS
+from lawbench.views.room import room_to_solve, unmappable
 
 
 class Drift(LawbenchError):
@@ -184,6 +185,8 @@ def _executor_arguments(parser: argparse.ArgumentParser, default: str) -> None:
 # The subcommands in the order ``lawbench --help`` lists them. Each module holds its command's
 # ``COMMAND`` (its name and parser settings), ``arguments`` and ``run``; the names are the
 # modules' in this package.
+# Commands that solve nothing, which need no room beyond the start's (`room_to_solve`).
+NO_SOLVE = ("list", "describe", "export")
 COMMANDS = (
     "listing",
     "describe",
@@ -306,6 +309,12 @@ def _main(argv: Sequence[str] | None, own_process: bool) -> int:
         return int(exit_.code or 0)
     except MemoryError:
         return _out_of_memory()
+    if args.command not in NO_SOLVE:
+        # Native libraries that run out of address space mid-solve abort, exit or hang.
+        short = room_to_solve()
+        if short:
+            _say(f"lawbench: out of memory: {short}")
+            return EXIT_CODES[SolverFailure]
     if own_process and getattr(args, "solves", False):
         # A command that solves: a law stuck in native code past its bound ends the process.
         end_process_when_stuck()
@@ -323,6 +332,9 @@ def _main(argv: Sequence[str] | None, own_process: bool) -> int:
     except MemoryError:
         return _out_of_memory()
     except OSError as exc:
+        if unmappable(exc):  # a library that the address space left cannot hold
+            _say(f"lawbench: out of memory while loading a library ({_one_line(exc)})")
+            return EXIT_CODES[SolverFailure]
         if isinstance(exc, BrokenPipeError) or exc.filename is None:
             raise  # the standard streams, which `main` handles
         return _os_error(exc)
