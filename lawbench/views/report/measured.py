@@ -126,10 +126,13 @@ def tasks(
 
     A law that follows the impact through time (an engine, or one that reads stiffness) is
     tens to hundreds of times slower than a closed form: it runs alone, so that the pool
-    spreads the set's work, and in the quick report within `STIFF_QUICK_S`. Each task is
-    ``(set name, laws, seconds)``.
+    spreads the set's work, and in the quick report within `STIFF_QUICK_S`. The quick report
+    leaves the engines to the full one: tuned, they step each fit's trial for up to tenths of a
+    second. Each task is ``(set name, laws, seconds)``.
     """
     mode = "quick" if quick else "full"
+    if quick:
+        names = [name for name in names if not LAWS.get(name).engine]
     stiff = [name for name in names if costly(LAWS.get(name))]
     rigid = [name for name in names if name not in stiff]
     seconds = STIFF_QUICK_S if quick else BUDGET_S[mode]
@@ -516,9 +519,10 @@ def _mode_text(found: Found) -> str:
             "half of each set; a law that reads stiffness (it integrates each impact in time) "
             f"is fitted on {measured.QUICK_COSTLY_FIT} and judged on "
             f"{measured.QUICK_COSTLY_JUDGE} of them within "
-            f"{STIFF_QUICK_S:g} s, a budget mark where that is too little; Kharaz's curves are "
-            "drawn at the digitized incidences only. `lawbench report --full` runs every "
-            "impact and the fine grid"
+            f"{STIFF_QUICK_S:g} s, a budget mark where that is too little; the engines are "
+            "fitted in the full report only; Kharaz's curves are drawn at the digitized "
+            "incidences only. `lawbench report --full` runs every impact, the engines and the "
+            "fine grid"
         )
     else:
         sample = (
