@@ -186,7 +186,7 @@ def test_an_engine_at_its_defaults_is_shown_with_the_tightest_level_it_reaches()
     )
     shown = answer.at_defaults(points)
     assert shown == "pybullet 0.34 (none within 0.01), mujoco 0.003 (within 0.01)"
-    assert answer.at_defaults(points.iloc[3:]) == "none"
+    assert answer.at_defaults(points.iloc[3:]) == "no engine answered"
 
 
 # In the browser: measured with the page's folds closed, then everything measured with them open.

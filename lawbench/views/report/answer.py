@@ -158,7 +158,8 @@ def at_defaults(data: pd.DataFrame) -> str:
     """Each engine's model error at its default options, and the tightest level it is within.
 
     An engine (`Law.engine`) runs in the speed/accuracy study at its default settings, what a
-    user gets; its point whose options are all the law's defaults is the one shown.
+    user gets; its point whose options are all the law's defaults is the one shown. On a scene
+    that declares no geometry every engine refuses, and no engine answered.
     """
     shown = []
     for _, row in data[data["model_error"].notna()].iterrows():
@@ -172,7 +173,7 @@ def at_defaults(data: pd.DataFrame) -> str:
         within = [level for level in LEVELS if error <= level]
         reached = f"within {min(within):g}" if within else f"none within {max(LEVELS):g}"
         shown.append(f"{row['law']} {error:.2g} ({reached})")
-    return ", ".join(shown) or "none"
+    return ", ".join(shown) or "no engine answered"
 
 
 def scene_row(case: Case, data: pd.DataFrame, costs: pd.Series, anchor: str) -> dict[str, Any]:
