@@ -11,6 +11,7 @@ import importlib
 import io
 import logging
 import os
+import resource
 import sys
 import warnings
 from collections.abc import Callable, Sequence
@@ -309,8 +310,10 @@ def _main(argv: Sequence[str] | None, own_process: bool) -> int:
         return int(exit_.code or 0)
     except MemoryError:
         return _out_of_memory()
-    if args.command not in NO_SOLVE:
-        # Native libraries that run out of address space mid-solve abort, exit or hang.
+    # Native libraries that run out of address space mid-solve abort, exit or hang; without an
+    # address-space limit every mapping is granted and there is nothing to check.
+    limited = resource.getrlimit(resource.RLIMIT_AS)[0] != resource.RLIM_INFINITY
+    if limited and args.command not in NO_SOLVE:
         short = room_to_solve()
         if short:
             _say(f"lawbench: out of memory: {short}")
