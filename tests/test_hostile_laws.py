@@ -93,7 +93,15 @@ def _runs_out_of_memory(self, problem, options):
     raise MemoryError
 
 
-def test_the_users_ctrl_c_still_interrupts():
+@pytest.fixture
+def python_s_sigint():
+    """SIGINT at Python's own handler, whatever this process's earlier work left it at."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_the_users_ctrl_c_still_interrupts(python_s_sigint):
     def pressed(self, problem, options):
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(2)
@@ -135,6 +143,15 @@ def test_a_law_that_exits_runs_out_of_memory_or_writes_into_its_input_fails(body
     are that law's failure, named."""
     with pytest.raises(SolverFailure, match=f"broken_test_law: .*{said}"):
         lawbench.solve(broken(body), ball())
+
+
+def test_a_write_into_a_shared_contact_reaches_no_later_problem():
+    """Problems of the same coefficients share one contact object: a law that forces e = 1
+    into it fails, and a problem built afterwards with e = 0.5 still has e = 0.5."""
+    with pytest.raises(SolverFailure, match="wrote into the problem"):
+        lawbench.solve(broken(_writes_contact), ball(0.5))
+    assert ball(0.5).contacts[0].e == 0.5
+    assert lawbench.solve("newton", ball(0.5)).v_plus[0] == pytest.approx(1.0)
 
 
 def test_lawbench_s_own_laws_still_have_their_options_and_problem_identity_checked():

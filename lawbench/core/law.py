@@ -60,7 +60,7 @@ from lawbench.core.guards import (
     verify_answer,
 )
 from lawbench.core.outcome import Outcome, embedded, scaled_back
-from lawbench.core.problem import ImpactProblem
+from lawbench.core.problem import ImpactProblem, forget_shared_contacts
 from lawbench.core.registry import Registry
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
@@ -385,6 +385,8 @@ class Law(ABC):
         now = inputs(problem, options, checksum)
         if now != given:
             what = "problem" if now[0] != given[0] else "options"
+            if what == "problem":
+                forget_shared_contacts()
             raise SolverFailure(f"{self.name}: the law wrote into the {what} it was given")
         verify_answer(self.name, problem, outcome)
         return outcome

@@ -197,6 +197,17 @@ def _rows_out_of_range(contacts: list[Contact], indices: list[int]) -> list[int]
     return [indices[row] for row in np.flatnonzero(bad)]
 
 
+def forget_shared_contacts() -> None:
+    """Build every shared contact anew from now on: one was written into (`Law._answer`).
+
+    A law that forces a write into a contact it was given (``object.__setattr__``) changes the
+    object every problem of the same coefficients shares; forgetting it keeps the write out of
+    the problems built afterwards.
+    """
+    _shared_contact.cache_clear()
+    _in_range.cache_clear()
+
+
 @functools.lru_cache(maxsize=256, typed=True)
 def _shared_contact(**coefficients: Any) -> Contact:
     """The one contact of coefficients every contact shares.
