@@ -198,22 +198,14 @@ def _rows_out_of_range(contacts: list[Contact], indices: list[int]) -> list[int]
 
 
 def forget_shared_contacts() -> None:
-    """Build every shared contact anew from now on: one was written into (`Law._answer`).
-
-    A law that forces a write into a contact it was given (``object.__setattr__``) changes the
-    object every problem of the same coefficients shares; forgetting it keeps the write out of
-    the problems built afterwards.
-    """
+    """Build shared contacts anew: a law forced a write into one it was given (`Law._answer`)."""
     _shared_contact.cache_clear()
     _in_range.cache_clear()
 
 
 @functools.lru_cache(maxsize=256, typed=True)
 def _shared_contact(**coefficients: Any) -> Contact:
-    """The one contact of coefficients every contact shares.
-
-    Typed: 1 and 1.0, equal as keys, build their own contact.
-    """
+    """The one contact of coefficients every contact shares (typed: 1 and 1.0 are two)."""
     return Contact(**coefficients)
 
 
