@@ -340,7 +340,8 @@ class KineticMetric:
             return self.solve_sparse(rhs)
         reciprocal = self.inverse_diagonal
         if reciprocal is not None:
-            return reciprocal * rhs if np.ndim(rhs) == 1 else reciprocal[:, None] * rhs
+            rhs = np.asarray(rhs)
+            return reciprocal * rhs if rhs.ndim == 1 else reciprocal[:, None] * rhs
         if self.inverse is not None:
             return self.inverse.dot(rhs)
         if self._factor is not None:

@@ -22,7 +22,7 @@ def generalized_impulse(
 ) -> np.ndarray:
     """Return the generalized impulse ``Wn @ Pn + Wt @ Pt`` (Pt None or empty: no friction)."""
     impulse = problem.Wn.dot(Pn)
-    if Pt is not None and np.size(Pt):
+    if Pt is not None and len(Pt):
         impulse = impulse + problem.Wt.dot(Pt)
     return impulse
 

@@ -333,13 +333,13 @@ def _two_contacts(G: np.ndarray, q: np.ndarray) -> tuple[list[float], list[float
     )
     floor = -COMPLEMENTARITY * max(abs(q0), abs(q1), ROUNDING)
     for z0, z1 in candidates:
-        if (z0 < 0.0 or z1 < 0.0) and min(z0, z1) < -COMPLEMENTARITY * max(
-            abs(z0), abs(z1), ROUNDING
-        ):
+        low = min(z0, z1)
+        if low < 0.0 and low < -COMPLEMENTARITY * max(abs(z0), abs(z1), ROUNDING):
             continue
-        w0, w1 = a * z0 + b * z1 + q0, c * z0 + d * z1 + q1
+        if not (a * z0 + b * z1 + q0 >= floor and c * z0 + d * z1 + q1 >= floor):
+            continue
         reach = max(abs(a * z0) + abs(b * z1), abs(c * z0) + abs(d * z1))
-        if w0 >= floor and w1 >= floor and math.isfinite(z0 + z1) and not _cancels(reach, floor):
+        if math.isfinite(z0 + z1) and not _cancels(reach, floor):
             z0, z1 = max(z0, 0.0), max(z1, 0.0)
             return [z0, z1], [a * z0 + b * z1 + q0, c * z0 + d * z1 + q1]
     return None
