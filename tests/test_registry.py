@@ -6,6 +6,8 @@ import types
 import pytest
 
 import lawbench
+from lawbench.core.errors import BudgetExceeded
+from lawbench.core.guards import alarm
 from lawbench.core.registry import Registry
 
 
@@ -44,3 +46,29 @@ def test_a_module_with_a_missing_dependency_is_skipped_with_its_reason(tmp_path,
     assert "a_package_that_is_not_installed" in registry.unavailable["heavy"]
     with pytest.raises(lawbench.InvalidProblem, match="missing dependency"):
         registry.get("heavy")
+
+
+def test_a_time_bound_that_rings_during_the_load_leaves_no_entry_behind(tmp_path, monkeypatch):
+    """A solve's alarm that rings while its worker imports the laws stops the solve, not the load.
+
+    Under load, a worker's first cell imported the law modules inside its time bound; the bound
+    stopped the import half-way and every later cell of that worker was refused with "unknown
+    law" for the modules after the stop. The bound still ends the call, once every module is in.
+    """
+    package = tmp_path / "slow_laws"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    for name, pause in (("first", 0.0), ("second", 0.3), ("third", 0.0)):
+        (package / f"{name}.py").write_text(
+            "import time, slow_registry\n"
+            f"time.sleep({pause})\n"
+            f"slow_registry.REGISTRY.register(type('Entry', (), {{'name': {name!r}}})())\n"
+        )
+    registry = Registry("law", "slow_laws", object)
+    holder = types.ModuleType("slow_registry")
+    holder.REGISTRY = registry
+    monkeypatch.setitem(sys.modules, "slow_registry", holder)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(BudgetExceeded), alarm(0.1):
+        registry.names()
+    assert registry.names() == ["first", "second", "third"]

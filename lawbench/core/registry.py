@@ -30,7 +30,7 @@ from collections.abc import Iterator, Mapping
 from typing import Any, Protocol, TypeVar
 
 from lawbench.core.errors import BudgetExceeded, UnknownName
-from lawbench.core.guards import alarm, from_user, user_interrupts
+from lawbench.core.guards import alarm, from_user, held, user_interrupts
 
 # Seconds a plugin's import may take before it is listed as unavailable: an import reads
 # modules and perhaps data, and lawbench's own slowest optional engine imports in about two.
@@ -95,6 +95,25 @@ class Registry(Mapping[str, Entry]):
         if self._loaded:
             return
         self._loaded = True
+        try:
+            with held():
+                self._import_modules()
+        except BaseException:
+            # A stop that rang meanwhile (held until every module was in): the next use
+            # finishes the load.
+            self._loaded = False
+            raise
+        for point in _entry_points(group=self.package):
+            reason = self._plug_guarded(point)
+            if reason:
+                self.unavailable[point.name] = f"plugin {point.value}: {reason}"
+
+    def _import_modules(self) -> None:
+        """Import every built-in module of the package, each registering its entries.
+
+        Run whole (`lawbench.core.guards.held`): a time bound that stopped the loop half-way
+        would leave the registry without the modules after it for the rest of the process.
+        """
         package = importlib.import_module(self.package)
         for module in sorted(pkgutil.iter_modules(package.__path__), key=lambda m: m.name):
             if module.name.startswith("_"):
@@ -103,10 +122,6 @@ class Registry(Mapping[str, Entry]):
                 importlib.import_module(f"{self.package}.{module.name}")
             except ImportError as exc:
                 self.unavailable[module.name] = f"missing dependency: {exc}"
-        for point in _entry_points(group=self.package):
-            reason = self._plug_guarded(point)
-            if reason:
-                self.unavailable[point.name] = f"plugin {point.value}: {reason}"
 
     def _load_one(self, name: str) -> None:
         """Import the built-in module called ``name``, or the plugin of that name, if any."""
@@ -115,7 +130,8 @@ class Registry(Mapping[str, Entry]):
         module = f"{self.package}.{name}"
         try:
             if importlib.util.find_spec(module) is not None:
-                importlib.import_module(module)
+                with held():  # a module stopped half-way would be left half-registered
+                    importlib.import_module(module)
                 return
         except ImportError:
             return  # the full load records why
