@@ -9,12 +9,14 @@ engine that builds and runs those studies is above them (`lawbench.studies`). Ma
 
 Single-solve checks read one trial (a law solved on a case): ``energy_gain``, ``energy_kept``,
 ``admissible``, ``impulse_sign``, ``friction_cone``, ``momentum``, ``reference``; `run_checks`
-runs them by default. ``continuity`` and ``dispersion`` solve the case again and run on request.
+runs them by default. ``continuity`` and ``dispersion`` solve the case again and run on request;
+``yardstick`` runs only in the studies that name it (`ON_REQUEST`).
 """
 
-from lawbench.checks import continuity, dispersion, outcome_checks
+from lawbench.checks import continuity, dispersion, outcome_checks, yardstick
 from lawbench.checks.outcome_checks import (
     CHECKS,
+    ON_REQUEST,
     SINGLE_SOLVE,
     CheckResult,
     CheckResults,
@@ -23,6 +25,7 @@ from lawbench.checks.outcome_checks import (
 
 __all__ = [
     "CHECKS",
+    "ON_REQUEST",
     "SINGLE_SOLVE",
     "CheckResult",
     "CheckResults",
@@ -30,4 +33,5 @@ __all__ = [
     "dispersion",
     "outcome_checks",
     "run_checks",
+    "yardstick",
 ]

@@ -10,6 +10,10 @@
   (`lawbench.checks.knobs.tightest`), the same way; 0 for an exact law, None for a knob that chooses
   between models (an ordering) rather than an accuracy.
 
+`model_distance` is the model error against the ground truth's model itself, where the truth
+has a closed form too (the yardstick check's companion, `lawbench.checks.yardstick`), and
+`model_seconds` that model's own wall time on the trial's problem.
+
 Both solve again in the worker; each answer is kept per process (`lawbench.checks.solved`),
 so a sweep pays for the ground truth once per worker. A measure returns None where it does not
 apply.
@@ -26,6 +30,7 @@ from lawbench.checks.dispersion import dispersion_index as _index
 from lawbench.checks.knobs import tightest
 from lawbench.checks.solved import digest, velocity_after
 from lawbench.core.errors import LawbenchError
+from lawbench.core.law import LAWS
 from lawbench.core.mechanics import energy_shares as _shares
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.trial import Trial
@@ -92,6 +97,32 @@ def numerical_error(trial: Trial) -> float | None:
     if not tight:
         return None
     return _distance(trial, _solve(law.name, {**trial.options, **tight}, trial.problem, trial))
+
+
+def _model(trial: Trial) -> tuple[str, dict[str, Any]] | None:
+    """The scene's ground-truth model and its options, None where it declares none."""
+    ground = trial.case.ground_truth if trial.case is not None else None
+    if ground is None or ground.law is None:
+        return None
+    return ground.law, dict(ground.options)
+
+
+def model_distance(trial: Trial) -> float | None:
+    """``max |v+ - v_model| / max |v-|`` against the ground truth's model, closed form aside."""
+    model = _model(trial)
+    return None if model is None else _distance(trial, _solve(*model, trial.problem, trial))
+
+
+def model_seconds(trial: Trial) -> float | None:
+    """The wall time of the ground truth's model on this trial's problem, solved afresh (s)."""
+    model = _model(trial)
+    if model is None:
+        return None
+    law, options = model
+    try:
+        return float(LAWS.get(law).resolve(trial.problem, **options).diagnostics["wall_time_s"])
+    except LawbenchError:
+        return None
 
 
 def truth_velocity(trial: Trial) -> list[float] | None:

@@ -129,10 +129,12 @@ Check = Callable[[Trial], CheckResult]
 CHECKS: dict[str, Check] = {}
 # The checks that read the one outcome of a trial; the others solve the problem again.
 SINGLE_SOLVE: list[str] = []
+# The checks that run only where a study names them, never among "every check".
+ON_REQUEST: list[str] = []
 
 
 def check(
-    name: str, several_solves: bool = False, promised: bool = False
+    name: str, several_solves: bool = False, promised: bool = False, on_request: bool = False
 ) -> Callable[[Callable[[Trial], tuple]], Check]:
     """Register a function returning ``(value, passed, detail)`` as the check ``name``.
 
@@ -140,6 +142,7 @@ def check(
     ``several_solves`` marks a check that solves the problem again (costly).
     ``promised`` marks a check every law promises everywhere (a failure is numerical unless a
     finding of the law says otherwise).
+    ``on_request`` marks a check that runs only in the studies that name it (`ON_REQUEST`).
     """
 
     def register(function: Callable[[Trial], tuple]) -> Check:
@@ -150,7 +153,9 @@ def check(
 
         run.__doc__ = function.__doc__
         CHECKS[name] = run
-        if not several_solves:
+        if on_request:
+            ON_REQUEST.append(name)
+        elif not several_solves:
             SINGLE_SOLVE.append(name)
         return run
 

@@ -27,6 +27,7 @@ ORTHOGONAL_DEG = 1e-6
 __all__ = [
     "EVERYWHERE",
     "coupled_friction",
+    "damped_contacts",
     "dissipative_contacts",
     "example",
     "frictional",
@@ -165,4 +166,15 @@ def _dissipative(trial: Any) -> bool:
 
 dissipative_contacts = Region(
     "several closed contacts, some dissipative (energetic e < 1)", _dissipative
+)
+
+
+def _damped(trial: Any) -> bool:
+    problem = trial.problem
+    e = problem.restitution("kinematic")[problem.closed]
+    return bool(((e > 0.0) & (e < 1.0)).any())
+
+
+damped_contacts = Region(
+    "a closed contact with 0 < e < 1 (a dashpot: neither elastic nor plastic)", _damped
 )

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.checks import CHECKS, SINGLE_SOLVE
+from lawbench.checks import CHECKS, ON_REQUEST, SINGLE_SOLVE
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem, LawbenchError
 from lawbench.core.law import LAWS, Law
@@ -29,7 +29,7 @@ from lawbench.core.verdicts import ACCEPTABLE, Verdict, of_error
 if TYPE_CHECKING:
     import pandas as pd
 
-SEVERAL_SOLVES = tuple(name for name in CHECKS if name not in SINGLE_SOLVE)
+SEVERAL_SOLVES = tuple(name for name in CHECKS if name not in (*SINGLE_SOLVE, *ON_REQUEST))
 COLUMNS = ("law", "scene", "example", "check", "verdict", "value", "detail", "claim")
 # Seeded random problems a check of a law adds at most.
 MAX_RANDOM = 100_000

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.checks import CHECKS, SINGLE_SOLVE, measures
+from lawbench.checks import CHECKS, ON_REQUEST, SINGLE_SOLVE, measures
 from lawbench.checks.knobs import decades
 from lawbench.core.case import CASES
 from lawbench.core.errors import InvalidProblem
@@ -286,13 +286,44 @@ def custom(shape: str, case: str, name: str, title: str, **fields: Any) -> Study
     return Study(name=name, title=title, cases=(case,), shape=shape, **fields)
 
 
+def yardstick(law: str, options: Mapping[str, Any], repeats: int = 2) -> Study:
+    """``law`` with ``options`` on every scene, against the scene's ground-truth model.
+
+    The ``yardstick`` check decides each cell (`lawbench.checks.yardstick`); the model's own
+    distance and wall time are measured beside it. Each cell is solved ``repeats`` times, so
+    that a cost can be read after a warm-up (an engine's first solve in a process loads it).
+    A slow study: an engine that integrates every impact in time takes seconds per scene.
+    """
+    return Study(
+        name=f"{law}_yardstick",
+        title=f"{law} ({', '.join(f'{k}={v}' for k, v in options.items())}) against each "
+        "scene's ground-truth model: the yardstick checked by an independent engine",
+        laws=(law,),
+        options={law: {name: [value] for name, value in options.items()}},
+        checks=("yardstick",),
+        measures={
+            "model_distance": measures.model_distance,
+            "model_seconds": measures.model_seconds,
+        },
+        repeats=repeats,
+        shape="yardstick",
+        slow=True,
+    )
+
+
 def summary() -> Study:
-    """The engine's own study: every law on every scene at its defaults, with every check."""
+    """The engine's own study: every law on every scene at its defaults, with every check.
+
+    Every check but those that run on request (`lawbench.checks.ON_REQUEST`).
+    """
     return Study(
         name="summary",
         title="every law on every scene at its defaults, with every check",
         laws="every",
-        checks=(*SINGLE_SOLVE, *(name for name in CHECKS if name not in SINGLE_SOLVE)),
+        checks=(
+            *SINGLE_SOLVE,
+            *(name for name in CHECKS if name not in SINGLE_SOLVE and name not in ON_REQUEST),
+        ),
         settings={"continuity_sizes": [1e-6]},
         measures={
             "model_error": measures.model_error,
@@ -324,6 +355,7 @@ SHAPES: dict[str, Callable[..., Study]] = {
     "impact_paths": impact_paths,
     "sweep": partial(custom, "sweep"),
     "table_path": partial(custom, "table_path"),
+    "yardstick": yardstick,
 }
 
 

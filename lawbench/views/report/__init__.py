@@ -7,8 +7,9 @@ figure as PNG and SVG with the CSV of its data, every table as CSV, every study'
 findings, every law against the measured impacts (fitted on one half of each set, judged on the
 other), outcomes beside the ground truth and the references, speed versus accuracy (model
 error and numerical error), stability at the extremes, energy-increase maps, dispersion and
-continuity, and paths inside an impact. Every cell carries a verdict; the headline counts the
-unexplained ones. A law or scene that is missing or fails is reported, never a crash.
+continuity, paths inside an impact, and the yardstick checked by an independent engine (the
+full report's). Every cell carries a verdict; the headline counts the unexplained ones. A law
+or scene that is missing or fails is reported, never a crash.
 """
 
 from __future__ import annotations

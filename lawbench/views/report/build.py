@@ -41,6 +41,7 @@ from lawbench.views.report import (
     summary,
     sweeps,
     tradeoff,
+    yardstick,
 )
 from lawbench.views.report.config import Config
 from lawbench.views.report.layout import arrange
@@ -65,6 +66,7 @@ SECTIONS: tuple[ModuleType, ...] = (
     dispersion,
     inside,
     sweeps,
+    yardstick,
 )
 TITLE = "lawbench: impact laws compared"
 # Seconds to draw one figure in a worker.

@@ -36,6 +36,7 @@ VIEWS = {
     "impact_paths": "inside",
     "sweep": "sweep",
     "table_path": "table_path",
+    "yardstick": "yardstick",
 }
 
 
