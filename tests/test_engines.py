@@ -48,6 +48,12 @@ SCENES = [
     ("rocking_block", {"width": 2.0, "height": 1.0}),
     ("bouncing_ball", {}),
     ("bouncing_ball", {"angular_velocity": [6.0, 6.0, 0.0], "radius": 0.2}),
+    ("falling_rod", {}),
+    ("falling_rod", {"angle": 80.0, "velocities": [0.5, -1.0, 2.0], "e": 0.8, "mu": 0.5}),
+    ("lamina", {}),
+    ("lamina", {"f0": -1.0, "h0": -0.5, "omega": 1.0}),
+    ("billiard", {}),
+    ("billiard", {"elevation": 0.0, "offset_side": 0.01, "offset_height": 0.0}),
 ]
 
 
@@ -80,7 +86,7 @@ def test_a_transformed_problem_is_refused_as_no_longer_its_geometry_s():
     with pytest.raises(lawbench.NotApplicable, match="the problem's M is not its geometry's"):
         lawbench.LAWS.get("mujoco").resolve(problem.in_units(2.0, 1.0, 1.0))
     with pytest.raises(lawbench.NotApplicable, match="the scene declares no geometry"):
-        lawbench.solve("mujoco", "lamina")
+        lawbench.solve("mujoco", "double_pendulum")
 
 
 def engine_columns_mujoco(problem):
@@ -142,12 +148,7 @@ def engine_columns_pybullet(problem, step=1e-7):
         for i in range(geometry.n):
             moved = []
             for h in (step, -step):
-                for uid, (position, (w, *q)) in zip(
-                    scene.ids, geometry.poses(start + h * np.eye(geometry.n)[i]), strict=True
-                ):
-                    pybullet.resetBasePositionAndOrientation(
-                        uid, list(position), [*q, w], physicsClientId=scene.client.id
-                    )
+                _place(scene, geometry, start, h * np.eye(geometry.n)[i])
                 moved.append(_closest(scene, problem, points))
             for j, (plus, minus) in enumerate(zip(*moved, strict=True)):
                 Wn[i, j] = (plus[0] - minus[0]) / (2 * step)
@@ -156,6 +157,43 @@ def engine_columns_pybullet(problem, step=1e-7):
     finally:
         scene.close()
     return Wn, Wt
+
+
+def _place(scene, geometry, start, displacement):
+    """Each body at its pose ``displacement`` from ``start``: a base by its pose, a link on a
+    hinge or slide by its joint's coordinate (zero at ``start``)."""
+    moves = geometry.body_velocities(displacement)
+    poses = geometry.poses(start + displacement)
+    for k, (uid, (position, (w, *q))) in enumerate(zip(scene.ids, poses, strict=True)):
+        link = scene.links[uid]
+        if link < 0:
+            pybullet.resetBasePositionAndOrientation(
+                uid, list(position), [*q, w], physicsClientId=scene.client.id
+            )
+            continue
+        joint = geometry.joint(geometry.bodies[k].name)
+        along = moves[k][3:] if joint.kind == "hinge" else moves[k][:3]
+        pybullet.resetJointState(
+            uid, link, float(along @ joint.axis), physicsClientId=scene.client.id
+        )
+
+
+def _frame(scene, uid):
+    """A world position and orientation of a frame fixed in body ``uid``.
+
+    A link's from its base and its joint's coordinate (getLinkState reports in single
+    precision): the base turned about a hinge's axis, or moved along a slide's.
+    """
+    link, client = scene.links[uid], scene.client.id
+    base = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)
+    if link < 0:
+        return base
+    geometry = scene.geometry
+    joint = geometry.joint(geometry.bodies[scene.ids.index(uid)].name)
+    value, axis = pybullet.getJointState(uid, link, physicsClientId=client)[0], joint.axis
+    if joint.kind == "slide":
+        return np.asarray(base[0]) + value * np.asarray(axis), (0.0, 0.0, 0.0, 1.0)
+    return base[0], (*(np.sin(value / 2) * np.asarray(axis)), np.cos(value / 2))
 
 
 def _closest(scene, problem, points=None):
@@ -170,9 +208,7 @@ def _closest(scene, problem, points=None):
         for point in pybullet.getClosestPoints(a, b, 1.0, physicsClientId=client):
             force = _base.Force(pair.a, pair.b, np.asarray(point[5]), np.zeros(3))
             j, _ = _base.pair_of(geometry, force)
-            frames = [
-                pybullet.getBasePositionAndOrientation(u, physicsClientId=client) for u in (a, b)
-            ]
+            frames = [_frame(scene, u) for u in (a, b)]
             if points is None:
                 on = [np.asarray(point[5]), np.asarray(point[6])]
                 local = [_to_body(frame, p) for frame, p in zip(frames, on, strict=True)]

@@ -15,13 +15,14 @@ is Coulomb's, regularized below the stiction tolerance in continuous time.
 
 Conventions: the common stepping rule of the engine laws (`lawbench.laws.engines._base`). Bodies:
 a rigid body per moving body, its frame at the centre of mass along the principal axes; a free
-joint is Drake's floating body, a planar joint Drake's PlanarJoint between a frame of the world
-and one of the body, both at the body's pose with z along the joint's axis; hinges and slides
-are not built; a fixed body's geometry is the world body's (plane: HalfSpace, its normal the
-frame's z). Only the declared pairs collide (every other two geometries are filtered out).
-Drake reports each point pair's force on its second geometry (PointPairContactInfo.contact_force,
-world frame). Gravity is off. Drake writes a warning for every half space, about deformable
-contact; it is filtered out of the ``drake`` logger.
+joint is Drake's floating body, a planar joint, a hinge and a slide Drake's PlanarJoint,
+RevoluteJoint and PrismaticJoint between a frame of the world and one of the body, both at the
+body's pose (a hinge's at its anchor) with z along the joint's axis; a fixed body's geometry
+is the world body's (plane: HalfSpace, its normal the frame's z). Only the declared pairs
+collide (every other two geometries are filtered out). Drake reports each point pair's force on
+its second geometry (PointPairContactInfo.contact_force, world frame). Gravity is off. Drake
+writes a warning for every half space, about deformable contact; it is filtered out of the
+``drake`` logger.
 
 Settings (option ``settings``):
 
