@@ -63,6 +63,35 @@ CORNER_RADIUS = 1e-3
 INSTALL = "pip install 'lawbench[engines]'"
 
 
+# A body that moves by more than this fraction of its largest size during the impact leaves the
+# configuration the problem is frozen at.
+MOVED = 0.5
+
+
+def _moved(trial: Any) -> bool:
+    """Whether a body's centre moves by more than `MOVED` of its largest size in the impact.
+
+    At the faster of its speeds before and after, over the engine's impact time.
+    """
+    geometry = getattr(trial.problem, "geometry", None)
+    seconds = trial.outcome.diagnostics.get("impact_time")
+    if geometry is None or seconds is None:
+        return False
+    speeds = [
+        np.linalg.norm(geometry.body_velocities(v)[:, :3], axis=1)
+        for v in (trial.problem.v, trial.outcome.v_plus)
+    ]
+    fastest = np.maximum(*speeds)
+    return any(
+        fastest[k] * seconds > MOVED * max(body.size)
+        for k, body in enumerate(geometry.bodies)
+        if body.size
+    )
+
+
+moving_impact = Region(
+    f"a body moves by more than {MOVED:g} of its size during the engine's impact", _moved
+)
 elastic_contact = Region(
     "some closed contact is elastic (e = 1)",
     lambda trial: bool((trial.problem.restitution("kinematic")[trial.problem.closed] == 1).any()),

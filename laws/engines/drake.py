@@ -91,6 +91,7 @@ from lawbench.laws.engines._base import (
     damping_for,
     elastic_contact,
     engine_options,
+    moving_impact,
     require,
 )
 from lawbench.laws.engines._drake_scene import DrakeScene, Tuning
@@ -257,6 +258,18 @@ class Drake(EngineLaw):
             "high landing at 5 m/s with e = 0 leaves with 1.2 times the energy it brought; at "
             "dt = 1e-4 s with 0.22 times)",
             (),
+        ),
+        Claim(
+            "admissible",
+            option("settings", "default") & moving_impact,
+            f"{_DOCS}: DefaultProximityProperties (point_stiffness 1e6 N/m), MultibodyPlantConfig "
+            "(time_step 1 ms)",
+            "at its defaults a contact is soft and stepped at 1 ms: the impact lasts long enough "
+            "for the bodies to leave the configuration the problem is frozen at, and a contact "
+            "the engine no longer meets is left approaching along its frozen normal (the "
+            "billiard shot lasts 16 ms, the ball slides out from under the tip: un+ = -0.24 "
+            "m/s)",
+            (("billiard", "default"),),
         ),
     )
 

@@ -76,6 +76,7 @@ from lawbench.laws.engines._base import (
     damping_for,
     elastic_contact,
     engine_options,
+    moving_impact,
     plane_axes,
     quietly,
     require,
@@ -151,6 +152,17 @@ class MuJoCo(EngineLaw):
     )
     findings = (
         RIGID_DISPERSION,
+        Claim(
+            "admissible",
+            option("settings", "default") & moving_impact,
+            f"{_DOCS}; Modeling: solver parameters (solref default 0.02, 1)",
+            "at its defaults a contact's time constant is 20 ms: the impact lasts long enough "
+            "for the bodies to leave the configuration the problem is frozen at, and a contact "
+            "the engine no longer meets is left approaching along its frozen normal (the "
+            "billiard shot lasts 26 ms, the ball slides 26 mm out from under the tip and the "
+            "cue passes it: un+ = -0.79 m/s)",
+            (("billiard", "default"),),
+        ),
         Claim(
             "continuity",
             oblique_contacts,
