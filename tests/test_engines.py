@@ -398,6 +398,24 @@ def test_pybullet_defaults_multiply_the_coefficients_and_keep_a_little_energy():
     assert np.linalg.norm(sphere.Pt) == pytest.approx(0.03**2 * sphere.Pn[0], rel=1e-9)
 
 
+def test_pybullet_defaults_widen_a_friction_cone_beyond_one_and_that_is_a_finding():
+    """The finding's witness: the sphere grazing a wall at 80 degrees (e = 0, no spin) with
+    mu = 1.2 on both bodies slides with Bullet's mu^2 = 1.44, outside the scene's cone: a law
+    property of the defaults, not a numerical failure; mu = 0.9 < 1 narrows the cone instead."""
+    widened = {"mu": 1.2, "angle": 80.0, "e": 0.0, "spin": [0.0, 0.0, 0.0]}
+    trial = lawbench.evaluate("pybullet", "sphere_wall", **widened)
+    outcome = trial.outcome
+    assert np.linalg.norm(outcome.Pt) == pytest.approx(1.2**2 * outcome.Pn[0], rel=1e-9)
+    result = lawbench.run_checks(trial, checks=["friction_cone"])["friction_cone"]
+    assert str(result.verdict) == "law property"
+    assert "product of its two bodies'" in result.claim.reason
+    narrowed = lawbench.evaluate("pybullet", "sphere_wall", **{**widened, "mu": 0.9})
+    assert not pybullet_law.widened_cone(narrowed)
+    assert lawbench.run_checks(narrowed, checks=["friction_cone"])["friction_cone"].passed
+    tuned = lawbench.evaluate("pybullet", "sphere_wall", {"settings": "tuned"}, **widened)
+    assert lawbench.run_checks(tuned, checks=["friction_cone"])["friction_cone"].passed
+
+
 def test_pybullet_meets_gaps_event_by_event():
     """Contact 1 open by a millimetre: Newton's cradle, as rigid binary impacts give."""
     outcome = lawbench.solve(

@@ -70,7 +70,7 @@ from lawbench.checks.regions import oblique_contacts, option, separating_contact
 from lawbench.core.errors import NotApplicable
 from lawbench.core.geometry import Body, Geometry, rotation_matrix
 from lawbench.core.law import LAWS
-from lawbench.core.verdicts import Claim
+from lawbench.core.verdicts import Claim, Region
 from lawbench.laws._claims import RIGID_DISPERSION
 from lawbench.laws.engines._base import (
     EngineLaw,
@@ -160,6 +160,28 @@ def _client(settings: str) -> _Client:
     return clients[settings]
 
 
+def _widened(trial: Any) -> bool:
+    """Whether a contact's friction at the defaults, its bodies' product, exceeds its mu.
+
+    Each body carries the mean mu of its pairs (`_means`), and Bullet gives a contact the
+    product of its two bodies' coefficients, at most `MAX_FRICTION`.
+    """
+    geometry = getattr(trial.problem, "geometry", None)
+    if geometry is None:
+        return False
+    means = _means(geometry, [pair.mu for pair in geometry.pairs])
+    index = geometry.index
+    return any(
+        min(means[index[pair.a]] * means[index[pair.b]], MAX_FRICTION) > pair.mu
+        for pair in geometry.pairs
+    )
+
+
+widened_cone = Region(
+    "a contact's friction, the product of its two bodies' coefficients, exceeds its mu", _widened
+)
+
+
 class PyBullet(EngineLaw):
     """Bullet Physics through PyBullet: the scene stepped with Bullet's impulse solver."""
 
@@ -222,6 +244,17 @@ class PyBullet(EngineLaw):
             "at 1e-4 s and a third (the plastic outcome) at 1e-5 s; the elastic rocking block "
             "keeps 88 %, its box landing on one point of its contact manifold, off its plane",
             (("three_ball_chain", "default"),),
+        ),
+        Claim(
+            "friction_cone",
+            option("settings", "default") & widened_cone,
+            f"{_QUICKSTART}: changeDynamics (restitution and lateralFriction are a body's); "
+            f"{_COMBINED}",
+            "at its defaults each body carries the scene's coefficients, and Bullet gives a "
+            "contact the product of its two bodies' (e1 e2 and mu1 mu2, the friction at most "
+            "10): a contact of e and mu acts with e^2 and mu^2, and where mu > 1 a sliding "
+            "contact's impulse leaves the scene's cone (the sphere grazing a wall at 80 degrees "
+            "with mu = 1.2 and e = 0 slides with |Pt| = 1.44 Pn)",
         ),
     )
     guarantees = (
