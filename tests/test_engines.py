@@ -416,6 +416,19 @@ def test_pybullet_defaults_widen_a_friction_cone_beyond_one_and_that_is_a_findin
     assert lawbench.run_checks(tuned, checks=["friction_cone"])["friction_cone"].passed
 
 
+def test_pybullet_tuned_gains_energy_where_the_slip_reverses_as_moreau_s_law_does():
+    """The finding's witness: tuned, the rod of the example 'energy gain' (e = 0.9, mu = 0.3,
+    its end coupled) leaves with 1.5 % more energy, Moreau's (and Whittaker's) answer."""
+    params = lawbench.CASES.get("falling_rod").examples["energy gain"]
+    trial = lawbench.evaluate("pybullet", "falling_rod", {"settings": "tuned"}, **params)
+    moreau = lawbench.solve("moreau", "falling_rod", **params)
+    assert relative(trial.outcome.v_plus, moreau.v_plus, trial.problem.v) < 1e-9
+    assert trial.outcome.T_plus / trial.problem.T_minus == pytest.approx(1.015, abs=1e-3)
+    result = lawbench.run_checks(trial, checks=["energy_gain"])["energy_gain"]
+    assert str(result.verdict) == "law property"
+    assert "Kane and Levinson" in result.claim.source
+
+
 def test_pybullet_meets_gaps_event_by_event():
     """Contact 1 open by a millimetre: Newton's cradle, as rigid binary impacts give."""
     outcome = lawbench.solve(

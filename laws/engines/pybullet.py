@@ -66,7 +66,12 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.checks.regions import oblique_contacts, option, separating_contact
+from lawbench.checks.regions import (
+    coupled_friction,
+    oblique_contacts,
+    option,
+    separating_contact,
+)
 from lawbench.core.errors import NotApplicable
 from lawbench.core.geometry import Body, Geometry, rotation_matrix
 from lawbench.core.law import LAWS
@@ -244,6 +249,17 @@ class PyBullet(EngineLaw):
             "at 1e-4 s and a third (the plastic outcome) at 1e-5 s; the elastic rocking block "
             "keeps 88 %, its box landing on one point of its contact manifold, off its plane",
             (("three_ball_chain", "default"),),
+        ),
+        Claim(
+            "energy_gain",
+            option("settings", "tuned") & coupled_friction,
+            f"Kane and Levinson 1985; Brogliato 2010, eqs. (6)-(9); {_SOLVER}",
+            "tuned, each step restitutes the contact by Newton's rule with Coulomb's friction on "
+            "the slip after the step, at one contact Whittaker's law (Brogliato 2010, eq. 8): "
+            "where inertia couples the normal and tangential directions the slip can reverse "
+            "and the impact end with more energy than it began with (Kane and Levinson's "
+            "paradox; the rod of falling_rod's example 'energy gain', +1.5 %, Moreau's answer to "
+            "1e-12)",
         ),
         Claim(
             "friction_cone",
