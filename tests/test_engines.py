@@ -480,6 +480,21 @@ def test_mujoco_defaults_ignore_e():
     assert chain.T_plus / chain.T_minus == pytest.approx(0.35, abs=0.02)
 
 
+def test_mujoco_tuned_friction_feeds_the_normal_spring_where_the_rows_are_coupled():
+    """The finding's witness: the lively lamina (e = 0.9, mu = 0.3, h0 = 1) leaves MuJoCo tuned
+    with 1.84 times its energy (measured), its normal impulse 2.93 against 1.90 without
+    friction, where the frictionless lamina leaves at e; a law property, not unexplained."""
+    lively = lawbench.CASES.get("lamina").examples["slip reversal, lively"]
+    trial = lawbench.evaluate("mujoco", "lamina", {"settings": "tuned"}, **lively)
+    assert trial.outcome.T_plus / trial.problem.T_minus == pytest.approx(1.84, abs=0.01)
+    assert trial.outcome.Pn[0] == pytest.approx(2.93, abs=0.01)
+    result = lawbench.run_checks(trial, checks=["energy_gain"])["energy_gain"]
+    assert str(result.verdict) == "law property"
+    assert "reference acceleration" in result.claim.reason
+    frictionless = lawbench.solve("mujoco", "lamina", {"settings": "tuned"}, **{**lively, "mu": 0})
+    assert frictionless.v_plus[0] == pytest.approx(0.9, abs=1e-3)
+
+
 def test_the_damping_ratio_inverts_the_restitution_of_a_released_oscillator():
     for e in (1e-3, 0.05, np.exp(-2.0), 0.3, 0.9):
         zeta = mujoco_law.damping_ratio(e)
