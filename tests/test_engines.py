@@ -495,6 +495,22 @@ def test_mujoco_tuned_friction_feeds_the_normal_spring_where_the_rows_are_couple
     assert frictionless.v_plus[0] == pytest.approx(0.9, abs=1e-3)
 
 
+@pytest.mark.parametrize(("engine", "speed"), [("mujoco", 1e-10), ("drake", 1e-8)])
+def test_an_engine_gives_back_the_starting_overlap_s_energy_on_a_grazing_approach(engine, speed):
+    """The finding's witnesses: the lamina approaching slower than its starting overlap (1.1e-10
+    m) per step leaves with more energy than it brought, a law property; at 1e-6 m/s it does
+    not gain."""
+    from lawbench.core.trial import make_trial
+
+    slow = make_trial(engine, "lamina", params={"e": 0.0}, transform=f"grazing={speed:g}")
+    result = lawbench.run_checks(slow, checks=["energy_gain"])["energy_gain"]
+    assert str(result.verdict) == "law property"
+    assert "starting overlap" in result.claim.region.text
+    faster = make_trial(engine, "lamina", params={"e": 0.0}, transform="grazing=1e-06")
+    assert not _base.slower_than_overlap(faster)
+    assert lawbench.run_checks(faster, checks=["energy_gain"])["energy_gain"].passed
+
+
 def test_the_damping_ratio_inverts_the_restitution_of_a_released_oscillator():
     for e in (1e-3, 0.05, np.exp(-2.0), 0.3, 0.9):
         zeta = mujoco_law.damping_ratio(e)

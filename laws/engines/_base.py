@@ -43,7 +43,7 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
-from lawbench.core.verdicts import Region
+from lawbench.core.verdicts import Claim, Region
 from lawbench.laws._options import bound
 
 # Steps in a row without contact force that end an impact (with no contact approaching).
@@ -92,6 +92,40 @@ def _moved(trial: Any) -> bool:
 moving_impact = Region(
     f"a body moves by more than {MOVED:g} of its size during the engine's impact", _moved
 )
+
+
+def _overlapped(trial: Any) -> bool:
+    """Whether the fastest approach covers less than the starting overlap within a step."""
+    geometry = getattr(trial.problem, "geometry", None)
+    dt = trial.outcome.diagnostics.get("dt")
+    if geometry is None or dt is None:
+        return False
+    overlap = OVERLAP * min(min(body.size) for body in geometry.bodies if body.size)
+    return float(-np.min(trial.problem.un, initial=0.0)) * dt < overlap
+
+
+slower_than_overlap = Region(
+    "the fastest approach covers less than the closed contacts' starting overlap within a step",
+    _overlapped,
+)
+
+
+def overlap_given_back(source: str, example: str) -> Claim:
+    """An engine gives back the energy of the starting overlap (`OVERLAP`) of a closed contact.
+
+    ``example`` is the measured instance, in words.
+    """
+    return Claim(
+        "energy_gain",
+        slower_than_overlap,
+        f"{source}; lawbench.laws.engines._base, the stepping rule (OVERLAP)",
+        "a closed contact starts 1e-9 of the smallest body into its other body, so that the "
+        "engine finds it, and the engine's contact gives back the energy of that overlap as it "
+        "opens: where the approach covers less than the overlap within a step (a grazing "
+        f"approach), that energy is of the order of the impact's or larger ({example})",
+    )
+
+
 elastic_contact = Region(
     "some closed contact is elastic (e = 1)",
     lambda trial: bool((trial.problem.restitution("kinematic")[trial.problem.closed] == 1).any()),
