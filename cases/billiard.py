@@ -16,7 +16,9 @@ orthogonal to ``n``) gets ``t . (v + w x p) - u (d . t)``: the column is ``(-d .
 spatial_column(p, t))``. 2, ball-table: the point ``r = (0, 0, -R)`` with normal ``(0, 0, 1)``
 and tangents x and y: gap rate ``vz``, slip ``(vx - R wy, vy + R wx)``. Before the shot the
 ball is at rest on the table (contact 2 closed, neither approaching nor separating) and the cue
-moves at ``speed``.
+moves at ``speed``. Geometry, for the engines: the ball a solid sphere on a free joint on the
+fixed table plane; the cue its tip, a sphere of radius `TIP_RADIUS` of the ball's on a slide
+joint along ``d``, touching the ball at ``p`` (its centre on the ball's radius through ``p``).
 
 Parameters (defaults, a masse shot on a pool table): ball ``mass`` 0.17 kg and ``radius``
 0.028575 m (57.15 mm diameter), ``cue_mass`` 0.54 kg, ``speed`` 3 m/s, ``elevation`` 70
@@ -48,8 +50,10 @@ import numpy as np
 from lawbench.cases import _specs
 from lawbench.cases._chains import exponent_spec, stiffness_ratio_spec
 from lawbench.cases._friction import springs_with_friction
+from lawbench.cases._geometry import picked, plane, solid_sphere
 from lawbench.core.case import CASES, Case, Params, Reference, per_item
 from lawbench.core.errors import InvalidProblem
+from lawbench.core.geometry import ContactPair, Geometry, Joint
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
@@ -64,6 +68,8 @@ TOUCHING = 1e-9
 # The ball's path on the cloth after the shot: how long, how many points.
 PATH_SECONDS = 1.0
 PATH_POINTS = 101
+# The cue's tip radius over the ball's (a 13 mm tip on a 57 mm ball).
+TIP_RADIUS = 0.23
 COORDINATES = ["u [m/s]"] + [f"v{a} [m/s]" for a in "xyz"] + [f"w{a} [rad/s]" for a in "xyz"]
 
 
@@ -85,6 +91,29 @@ def cue_geometry(p: Params) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[n
     first = np.cross(n, side)
     first /= np.linalg.norm(first)
     return d, r, n, (first, np.cross(n, first))
+
+
+def shot_geometry(p: Params) -> Geometry:
+    """The cue's tip on a slide joint along ``d``, the ball on a free joint, the table plane.
+
+    The generalized velocity ``(u, v, w)`` gives the cue ``u d`` and the ball ``(v, w)``.
+    """
+    d, r, n, tangents = cue_geometry(p)
+    radius, tip = p["radius"], TIP_RADIUS * p["radius"]
+    centre = np.array([0.0, 0.0, radius])
+    ball = solid_sphere("ball", p["mass"], radius, centre)
+    cue = solid_sphere("cue", p["cue_mass"], tip, centre + r - tip * n)
+    table = plane("table", (0.0, 0.0, 0.0), TABLE_NORMAL)
+    pairs = [
+        ContactPair("ball", "cue", centre + r, n, tangents, p["e"][0], p["mu"][0]),
+        ContactPair(
+            "ball", "table", (0, 0, 0), TABLE_NORMAL, TABLE_TANGENTS, p["e"][1], p["mu"][1]
+        ),
+    ]
+    joints = [Joint("free", "ball"), Joint("slide", "cue", d), Joint("fixed", "table")]
+    to_bodies = picked([ball, cue, table], [(1, 0)] + [(0, k) for k in range(6)])
+    to_bodies[6:9, 0] = d
+    return Geometry((ball, cue, table), tuple(joints), tuple(pairs), to_bodies, to_bodies.T)
 
 
 def _straight_shot(p: Params) -> np.ndarray:
@@ -130,6 +159,8 @@ class Billiard(Case):
         exponent_spec(),
     )
     requires = Tags(friction=True, several_contacts=True, spatial=True)
+    # Stepping the engines through this scene's studies adds seconds to the quick report.
+    quick_engines = False
     ground_truth = springs_with_friction(
         "the cue's compliance against the table's decides how the two contacts share the "
         "impact, and the cue's tip grips or slides on the ball (Jia 2013)"
@@ -191,6 +222,7 @@ class Billiard(Case):
             v=np.array([params["speed"], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
             contacts=contacts,
             bodies={"cue": (0,), "ball": tuple(range(1, 7))},
+            geometry=shot_geometry(params),
         )
 
     def coordinates(self, params: Params) -> list[str]:

@@ -4,6 +4,10 @@ Generalized coordinates: the angular velocity ``omega`` of the lamina about O (r
 contact point sits so that its normal velocity (positive away from the anvil) is ``f0 * omega``
 and its tangential velocity ``h0 * omega``: ``Wn = [[f0]]``, ``Wt = [[h0]]`` and the mass matrix
 is the moment of inertia about O, ``M = [[inertia]]``. Gravity is ignored during the impact.
+Geometry, for the engines: the lamina's striking part a solid ball on a hinge through O (axis z,
+a massless arm), touching the anvil, the fixed plane ``y = -h0`` below it, at the contact point
+``(f0, -h0, 0)`` from O, normal y and tangent x, so that the contact point moves at
+``omega (h0, f0, 0)``; the ball's mass makes its moment of inertia about O the lamina's.
 
 Parameters (defaults): ``inertia`` 1 kg m^2; ``omega`` -1 rad/s (pre-impact, approaching the
 anvil when ``f0 * omega < 0``); ``f0`` 1 m and ``h0`` 0.5 m (lever arms of the normal and
@@ -24,6 +28,7 @@ friction cone contains O) sticking is permanent once reached and the impact is p
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -31,11 +36,15 @@ import numpy as np
 
 from lawbench.cases import _specs
 from lawbench.cases._friction import springs_with_friction
+from lawbench.cases._geometry import plane, solid_sphere
 from lawbench.core.case import CASES, Case, Params, Reference
+from lawbench.core.geometry import ContactPair, Geometry, Joint
 from lawbench.core.problem import Contact, ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
 
+# The radius of the ball that strikes the anvil, over the contact point's distance from O.
+BALL_RADIUS = 0.1
 _SOURCE = "Lubarda 2010 as given by Brogliato 2010, lamina on an anvil, eqs. (12)-(14)"
 
 
@@ -87,6 +96,32 @@ def _termination(name: str, factor: Any, formula: str) -> Reference:
     )
 
 
+@functools.lru_cache(maxsize=64)
+def _geometry(inertia: float, f0: float, h0: float, e: float, mu: float) -> Geometry | None:
+    """The striking ball on a hinge through O, against the anvil plane ``y = -h0``.
+
+    None when the contact point is O itself (no lever arm: nothing for an engine to turn).
+    Cached: a geometry is immutable, and a sweep of omega keeps it.
+    """
+    arm = math.hypot(f0, h0)
+    if arm == 0:
+        return None
+    radius = BALL_RADIUS * arm
+    centre = (f0, radius - h0, 0.0)
+    # A solid ball's moment of inertia about O: m (|centre|^2 + 2 radius^2 / 5).
+    mass = inertia / (f0**2 + (radius - h0) ** 2 + 0.4 * radius**2)
+    ball = solid_sphere("lamina", mass, radius, centre)
+    anvil = plane("anvil", (f0, -h0, 0.0), (0.0, 1.0, 0.0))
+    pair = ContactPair("lamina", "anvil", (f0, -h0, 0.0), (0, 1, 0), ((1, 0, 0),), e, mu)
+    joints = [Joint("hinge", "lamina", (0.0, 0.0, 1.0)), Joint("fixed", "anvil")]
+    # omega turns the ball about O: its centre moves at omega z x centre.
+    to_bodies = np.zeros((12, 1))
+    to_bodies[:6, 0] = (-centre[1], centre[0], 0.0, 0.0, 0.0, 1.0)
+    to_generalized = np.zeros((1, 12))
+    to_generalized[0, 5] = 1.0
+    return Geometry((ball, anvil), tuple(joints), (pair,), to_bodies, to_generalized)
+
+
 class Lamina(Case):
     """A lamina pivoted at O strikes an anvil with friction (one planar contact)."""
 
@@ -116,6 +151,8 @@ class Lamina(Case):
         _specs.friction(0.5),
     )
     requires = Tags(friction=True)
+    # Stepping the engines through this scene's studies adds seconds to the quick report.
+    quick_engines = False
     ground_truth = springs_with_friction(
         "on the lamina the slip can stop and stick during the impact, which decides between "
         "Lubarda's closed forms (one per termination of the rigid impulse dynamics)"
@@ -148,6 +185,9 @@ class Lamina(Case):
             v=[params["omega"]],
             contacts=[Contact(e=params["e"], mu=params["mu"])],
             bodies={"lamina": [0]},
+            geometry=_geometry(
+                params["inertia"], params["f0"], params["h0"], params["e"], params["mu"]
+            ),
         )
 
     def coordinates(self, params: Params) -> list[str]:

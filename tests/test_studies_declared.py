@@ -154,3 +154,19 @@ def test_the_quick_speed_accuracy_study_measures_a_thinned_law_for_model_error_b
     }
     full = study.preset("full").plan(laws, ["rocking_block"])
     assert all(set(full.measures_of(job)) == every for job in full.jobs)
+
+
+def test_the_quick_report_leaves_the_engines_to_the_full_one_where_a_scene_asks():
+    """The rod, the lamina and the billiard shot leave their engine cells to the full report;
+    the rocking block keeps them in the quick one."""
+    engines = {law.name for law in LAWS.values() if law.engine}
+    if not engines:
+        pytest.skip("no engine installed")
+    for case, kept in (("falling_rod", False), ("lamina", False), ("billiard", False)):
+        assert CASES.get(case).quick_engines is kept
+    for name, kept in (("falling_rod_speed_accuracy", False), ("rocking_block_friction", True)):
+        study = STUDIES.get(name)
+        quick = {job.law for job in study.preset("quick").jobs()}
+        full = {job.law for job in study.preset("full").jobs()}
+        assert engines <= full
+        assert (engines <= quick) is kept and (not engines & quick) is not kept

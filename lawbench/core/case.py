@@ -119,6 +119,9 @@ class Case(ABC):
     examples: ClassVar[Mapping[str, Params]] = {"default": {}}
     # The roles the scene plays in ``lawbench bench`` (`lawbench.bench.roles.ROLES`).
     bench_roles: ClassVar[tuple[str, ...]] = ()
+    # Whether the quick report steps the engines on the scene (their cells cost the most);
+    # False leaves them to the full report.
+    quick_engines: ClassVar[bool] = True
 
     def parameters(self, **given: Any) -> dict[str, Any]:
         """Every parameter, defaults filled in, checked and converted.

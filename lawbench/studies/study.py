@@ -240,6 +240,9 @@ class Study:
     costly_measures : tuple of str or None
         With ``costly_points``, the measures such a law's cells are given (None: every one),
         but on a scene whose ground truth is that law's answer: the yardstick keeps them all.
+    every_engine : bool
+        False (the quick report) leaves out the engines' cells on the scenes that leave them
+        to the full report (``Case.quick_engines``).
     """
 
     name: str
@@ -264,6 +267,7 @@ class Study:
     quick: Mapping[str, Any] = field(default_factory=dict)
     costly_points: int | None = None
     costly_measures: tuple[str, ...] | None = None
+    every_engine: bool = True
 
     def __post_init__(self) -> None:
         if isinstance(self.laws, str) and self.laws not in LAW_CHOICES:
@@ -290,7 +294,9 @@ class Study:
 
     def preset(self, mode: str) -> Study:
         """The study as the report's ``mode`` ('quick' or 'full') runs it."""
-        return dataclasses.replace(self, **(self.full if mode == "full" else self.quick))
+        if mode == "full":
+            return dataclasses.replace(self, **self.full)
+        return dataclasses.replace(self, **self.quick, every_engine=False)
 
     def with_params(self, given: Mapping[str, Any]) -> Study:
         """The study with parameters fixed (a grid parameter given is no longer swept)."""
@@ -304,7 +310,8 @@ class Study:
 
         Scenes outermost, then laws, the parameter grid, the option grid, the transform values
         and the repeats. A law that follows the impact through time is given ``costly_points``
-        points of each of them when that is set, and its accuracy knob at its default.
+        points of each of them when that is set, and its accuracy knob at its default; an
+        engine none on a scene that leaves it to the full report, unless ``every_engine``.
 
         Raises
         ------
@@ -323,6 +330,8 @@ class Study:
                 if laws is not None and law_name not in laws:
                     continue
                 law = LAWS.get(law_name)
+                if law.engine and not (self.every_engine or case.quick_engines):
+                    continue
                 count = self.costly_points if costly(law) else None
                 option_grid = {k: list(v) for k, v in self.options.get(law_name, {}).items()}
                 if self.knobs:

@@ -43,7 +43,7 @@ from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
-from lawbench.core.verdicts import Region
+from lawbench.core.verdicts import Claim, Region
 from lawbench.laws._options import bound
 
 # Steps in a row without contact force that end an impact (with no contact approaching).
@@ -61,6 +61,69 @@ OVERLAP = 1e-9
 CORNER_RADIUS = 1e-3
 # The install command of the engines.
 INSTALL = "pip install 'lawbench[engines]'"
+
+
+# A body that moves by more than this fraction of its largest size during the impact leaves the
+# configuration the problem is frozen at.
+MOVED = 0.5
+
+
+def _moved(trial: Any) -> bool:
+    """Whether a body's centre moves by more than `MOVED` of its largest size in the impact.
+
+    At the faster of its speeds before and after, over the engine's impact time.
+    """
+    geometry = getattr(trial.problem, "geometry", None)
+    seconds = trial.outcome.diagnostics.get("impact_time")
+    if geometry is None or seconds is None:
+        return False
+    speeds = [
+        np.linalg.norm(geometry.body_velocities(v)[:, :3], axis=1)
+        for v in (trial.problem.v, trial.outcome.v_plus)
+    ]
+    fastest = np.maximum(*speeds)
+    return any(
+        fastest[k] * seconds > MOVED * max(body.size)
+        for k, body in enumerate(geometry.bodies)
+        if body.size
+    )
+
+
+moving_impact = Region(
+    f"a body moves by more than {MOVED:g} of its size during the engine's impact", _moved
+)
+
+
+def _overlapped(trial: Any) -> bool:
+    """Whether the fastest approach covers less than the starting overlap within a step."""
+    geometry = getattr(trial.problem, "geometry", None)
+    dt = trial.outcome.diagnostics.get("dt")
+    if geometry is None or dt is None:
+        return False
+    overlap = OVERLAP * min(min(body.size) for body in geometry.bodies if body.size)
+    return float(-np.min(trial.problem.un, initial=0.0)) * dt < overlap
+
+
+slower_than_overlap = Region(
+    "the fastest approach covers less than the closed contacts' starting overlap within a step",
+    _overlapped,
+)
+
+
+def overlap_given_back(source: str, example: str) -> Claim:
+    """An engine gives back the energy of the starting overlap (`OVERLAP`) of a closed contact.
+
+    ``example`` is the measured instance, in words.
+    """
+    return Claim(
+        "energy_gain",
+        slower_than_overlap,
+        f"{source}; lawbench.laws.engines._base, the stepping rule (OVERLAP)",
+        "a closed contact starts 1e-9 of the smallest body into its other body, so that the "
+        "engine finds it, and the engine's contact gives back the energy of that overlap as it "
+        "opens: where the approach covers less than the overlap within a step (a grazing "
+        f"approach), that energy is of the order of the impact's or larger ({example})",
+    )
 
 
 elastic_contact = Region(

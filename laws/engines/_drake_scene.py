@@ -9,14 +9,14 @@ from __future__ import annotations
 import functools
 import importlib
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 
-from lawbench.core.errors import NotApplicable
-from lawbench.core.geometry import Body, rotation_matrix
+from lawbench.core.geometry import Body, Joint, rotation_matrix
 from lawbench.laws.engines._base import Force, Scene, Start, corner, plane_axes
 
 # Drake's warning at every half space it is given, about deformable bodies this law never makes.
@@ -175,46 +175,61 @@ class DrakeScene(Scene):
     def _bodies(self, poses: list[tuple[np.ndarray, tuple[float, ...]]]) -> list[Any]:
         """Each body's Drake body (the world body for a fixed one), its joint made.
 
-        A free body is Drake's floating body. A planar joint joins a frame of the world at the
-        body's pose, its z the joint's axis, to the same frame on the body, so that the joint's
-        coordinates are zero at the pose; Drake's planar joint moves the child frame in the
-        parent's x-y plane and turns it about z.
-
-        Raises
-        ------
-        NotApplicable
-            For a hinge or a slide.
+        A free body is Drake's floating body; the other joints are `_joint`'s.
         """
-        drake, plant, made = self.drake, self.plant, []
-        tree = drake.multibody_tree
-        self.planar: dict[int, tuple[Any, np.ndarray]] = {}
+        plant, made = self.plant, []
+        tree = self.drake.multibody_tree
+        # Each jointed body's velocity setter: (context, v, w) -> None.
+        self.jointed: dict[int, Callable[[Any, np.ndarray, np.ndarray], None]] = {}
         for k, body in enumerate(self.geometry.bodies):
             joint = self.geometry.joint(body.name)
             if joint.kind == "fixed":
                 made.append(plant.world_body())
                 continue
-            if joint.kind not in ("free", "planar"):
-                raise NotApplicable(
-                    f"drake: the scene's {joint.kind} joint is not built (free, planar and "
-                    "fixed joints are)"
-                )
             inertia = tree.SpatialInertia.MakeFromCentralInertia(
                 body.mass, np.zeros(3), tree.RotationalInertia(*body.inertia)
             )
             rigid = plant.AddRigidBody(f"b{k}", inertia)
             made.append(rigid)
-            if joint.kind == "planar":
-                position, quaternion = poses[k]
-                axis = np.asarray(joint.axis)
-                R_WF = np.column_stack([*plane_axes(axis), axis])
-                X_WF = _transform(drake, R_WF, position)
-                X_BF = _transform(drake, rotation_matrix(quaternion), position).inverse()
-                F = plant.AddFrame(tree.FixedOffsetFrame(f"F{k}", plant.world_frame(), X_WF))
-                M = plant.AddFrame(
-                    tree.FixedOffsetFrame(f"M{k}", rigid.body_frame(), X_BF.multiply(X_WF))
-                )
-                self.planar[k] = (plant.AddJoint(tree.PlanarJoint(f"J{k}", F, M)), R_WF)
+            if joint.kind != "free":
+                self.jointed[k] = self._joint(k, rigid, joint, poses[k])
         return made
+
+    def _joint(
+        self, k: int, rigid: Any, joint: Joint, pose: tuple[np.ndarray, tuple[float, ...]]
+    ) -> Callable[[Any, np.ndarray, np.ndarray], None]:
+        """Join body k to the world; return the setter of its velocity (context, v, w).
+
+        A frame of the world, its z the joint's axis, at the hinge's anchor (at the body's
+        centre for the other joints), is joined to the same frame fixed on the body, so that the
+        joint's coordinates are zero at the pose: Drake's PlanarJoint moves the child frame in
+        the parent's x-y plane and turns it about z, its RevoluteJoint turns it about z, its
+        PrismaticJoint slides it along z.
+        """
+        drake, plant = self.drake, self.plant
+        tree = drake.multibody_tree
+        position, quaternion = pose
+        axis = np.asarray(joint.axis)
+        R_WF = np.column_stack([*plane_axes(axis), axis])
+        origin = joint.anchor if joint.kind == "hinge" else position
+        X_WF = _transform(drake, R_WF, origin)
+        X_BW = _transform(drake, rotation_matrix(quaternion), position).inverse()
+        F = plant.AddFrame(tree.FixedOffsetFrame(f"F{k}", plant.world_frame(), X_WF))
+        M = plant.AddFrame(tree.FixedOffsetFrame(f"M{k}", rigid.body_frame(), X_BW.multiply(X_WF)))
+        z = np.array([0.0, 0.0, 1.0])
+        if joint.kind == "hinge":
+            made = plant.AddJoint(tree.RevoluteJoint(f"J{k}", F, M, z))
+            return lambda context, v, w: made.set_angular_rate(context, float(axis @ w))
+        if joint.kind == "slide":
+            made = plant.AddJoint(tree.PrismaticJoint(f"J{k}", F, M, z))
+            return lambda context, v, w: made.set_translation_rate(context, float(axis @ v))
+        made = plant.AddJoint(tree.PlanarJoint(f"J{k}", F, M))
+
+        def planar(context: Any, v: np.ndarray, w: np.ndarray) -> None:
+            made.set_translational_velocity(context, (R_WF.T @ v)[:2])
+            made.set_angular_velocity(context, float(axis @ w))
+
+        return planar
 
     def _geometries(
         self,
@@ -329,10 +344,8 @@ class DrakeScene(Scene):
         drake, plant, context = self.drake, self.plant, self.context
         for k, rigid in enumerate(self.bodies):
             v, w = velocities[k][:3], velocities[k][3:]
-            if k in self.planar:
-                joint, R_WF = self.planar[k]
-                joint.set_translational_velocity(context, (R_WF.T @ v)[:2])
-                joint.set_angular_velocity(context, float(R_WF[:, 2] @ w))
+            if k in self.jointed:
+                self.jointed[k](context, v, w)
             elif self.geometry.moving(self.geometry.bodies[k].name):
                 position, quaternion = poses[k]
                 pose = _transform(drake, rotation_matrix(quaternion), position)

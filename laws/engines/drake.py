@@ -15,13 +15,14 @@ is Coulomb's, regularized below the stiction tolerance in continuous time.
 
 Conventions: the common stepping rule of the engine laws (`lawbench.laws.engines._base`). Bodies:
 a rigid body per moving body, its frame at the centre of mass along the principal axes; a free
-joint is Drake's floating body, a planar joint Drake's PlanarJoint between a frame of the world
-and one of the body, both at the body's pose with z along the joint's axis; hinges and slides
-are not built; a fixed body's geometry is the world body's (plane: HalfSpace, its normal the
-frame's z). Only the declared pairs collide (every other two geometries are filtered out).
-Drake reports each point pair's force on its second geometry (PointPairContactInfo.contact_force,
-world frame). Gravity is off. Drake writes a warning for every half space, about deformable
-contact; it is filtered out of the ``drake`` logger.
+joint is Drake's floating body, a planar joint, a hinge and a slide Drake's PlanarJoint,
+RevoluteJoint and PrismaticJoint between a frame of the world and one of the body, both at the
+body's pose (a hinge's at its anchor) with z along the joint's axis; a fixed body's geometry
+is the world body's (plane: HalfSpace, its normal the frame's z). Only the declared pairs
+collide (every other two geometries are filtered out). Drake reports each point pair's force on
+its second geometry (PointPairContactInfo.contact_force, world frame). Gravity is off. Drake
+writes a warning for every half space, about deformable contact; it is filtered out of the
+``drake`` logger.
 
 Settings (option ``settings``):
 
@@ -100,6 +101,8 @@ from lawbench.laws.engines._base import (
     damping_for,
     elastic_contact,
     engine_options,
+    moving_impact,
+    overlap_given_back,
     require,
 )
 from lawbench.laws.engines._drake_scene import DrakeScene, Tuning
@@ -235,6 +238,10 @@ class Drake(EngineLaw):
         f"speed, stiction tolerance {STICTION:g} m/s",
     )
     findings = (
+        overlap_given_back(
+            f"{_DOCS}: DefaultProximityProperties (point_stiffness 1e6 N/m)",
+            "the lamina approaching at 1e-8 m/s gains 1.1e-15 J where it brought 5e-17 J",
+        ),
         Claim(
             "dispersion",
             option("settings", "tuned") & nonlinear_springs,
@@ -314,6 +321,18 @@ class Drake(EngineLaw):
             "high landing at 5 m/s with e = 0 leaves with 1.2 times the energy it brought; at "
             "dt = 1e-4 s with 0.22 times)",
             (),
+        ),
+        Claim(
+            "admissible",
+            option("settings", "default") & moving_impact,
+            f"{_DOCS}: DefaultProximityProperties (point_stiffness 1e6 N/m), MultibodyPlantConfig "
+            "(time_step 1 ms)",
+            "at its defaults a contact is soft and stepped at 1 ms: the impact lasts long enough "
+            "for the bodies to leave the configuration the problem is frozen at, and a contact "
+            "the engine no longer meets is left approaching along its frozen normal (the "
+            "billiard shot lasts 16 ms, the ball slides out from under the tip: un+ = -0.24 "
+            "m/s)",
+            (("billiard", "default"),),
         ),
         *_YARDSTICK,
     )

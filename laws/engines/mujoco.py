@@ -62,7 +62,7 @@ from types import ModuleType
 
 import numpy as np
 
-from lawbench.checks.regions import oblique_contacts, option
+from lawbench.checks.regions import coupled_friction, oblique_contacts, option
 from lawbench.core.errors import NotApplicable
 from lawbench.core.geometry import Body, ContactPair, rotation_matrix
 from lawbench.core.law import LAWS
@@ -76,6 +76,8 @@ from lawbench.laws.engines._base import (
     damping_for,
     elastic_contact,
     engine_options,
+    moving_impact,
+    overlap_given_back,
     plane_axes,
     quietly,
     require,
@@ -151,6 +153,35 @@ class MuJoCo(EngineLaw):
     )
     findings = (
         RIGID_DISPERSION,
+        overlap_given_back(
+            _DOCS, "the lamina approaching at 1e-10 m/s gains 3.2e-18 J where it brought 5e-21 J"
+        ),
+        Claim(
+            "energy_gain",
+            option("settings", "tuned") & coupled_friction,
+            f"{_DOCS}: a reference acceleration per constraint row; Todorov 2014, "
+            "analytically-invertible dynamics with contacts and constraints",
+            "MuJoCo's contact force derives from no potential and no dissipation: each row of a "
+            "contact, normal and frictional, has a reference acceleration (the normal one a "
+            "damped spring, tuned), and the solver finds the forces in the cone that best meet "
+            "them together. Where inertia couples a contact's normal and tangential rows, the "
+            "friction's force feeds the normal row's spring and the normal impulse grows with "
+            "friction: the lamina of the example 'slip reversal, lively' (one coordinate for "
+            "both rows, e = 0.9, mu = 0.3) takes Pn = 2.93 against 1.90 without friction and "
+            "leaves with 1.84 times its energy, the same at dt = 1e-6 s; the rod of the example "
+            "'energy gain' with 1.07 times",
+        ),
+        Claim(
+            "admissible",
+            option("settings", "default") & moving_impact,
+            f"{_DOCS}; Modeling: solver parameters (solref default 0.02, 1)",
+            "at its defaults a contact's time constant is 20 ms: the impact lasts long enough "
+            "for the bodies to leave the configuration the problem is frozen at, and a contact "
+            "the engine no longer meets is left approaching along its frozen normal (the "
+            "billiard shot lasts 26 ms, the ball slides 26 mm out from under the tip and the "
+            "cue passes it: un+ = -0.79 m/s)",
+            (("billiard", "default"),),
+        ),
         Claim(
             "continuity",
             oblique_contacts,

@@ -20,7 +20,9 @@ setting (a client takes 50 ms to connect), which sorts its overlapping pairs
 the client solved before. Joints: a free joint is a Bullet base with mass, a fixed one a base
 without; Bullet has no planar joint, so a planar body is a free one whose contact forces lie in
 its plane of motion (the rocking block's contact points lie in the plane through its centre of
-mass, so its motion stays planar); hinges and slides are not built.
+mass, so its motion stays planar); a hinge or a slide is a link of a fixed base without
+shape, its revolute or prismatic joint at the hinge's anchor (at the body's centre of mass for a
+slide) and its velocity motor off (PyBullet's joints are motorized by default).
 
 Settings (option ``settings``):
 
@@ -64,11 +66,16 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.checks.regions import oblique_contacts, option, separating_contact
+from lawbench.checks.regions import (
+    coupled_friction,
+    oblique_contacts,
+    option,
+    separating_contact,
+)
 from lawbench.core.errors import NotApplicable
-from lawbench.core.geometry import Body, Geometry
+from lawbench.core.geometry import Body, Geometry, rotation_matrix
 from lawbench.core.law import LAWS
-from lawbench.core.verdicts import Claim
+from lawbench.core.verdicts import Claim, Region
 from lawbench.laws._claims import RIGID_DISPERSION
 from lawbench.laws.engines._base import (
     EngineLaw,
@@ -158,6 +165,28 @@ def _client(settings: str) -> _Client:
     return clients[settings]
 
 
+def _widened(trial: Any) -> bool:
+    """Whether a contact's friction at the defaults, its bodies' product, exceeds its mu.
+
+    Each body carries the mean mu of its pairs (`_means`), and Bullet gives a contact the
+    product of its two bodies' coefficients, at most `MAX_FRICTION`.
+    """
+    geometry = getattr(trial.problem, "geometry", None)
+    if geometry is None:
+        return False
+    means = _means(geometry, [pair.mu for pair in geometry.pairs])
+    index = geometry.index
+    return any(
+        min(means[index[pair.a]] * means[index[pair.b]], MAX_FRICTION) > pair.mu
+        for pair in geometry.pairs
+    )
+
+
+widened_cone = Region(
+    "a contact's friction, the product of its two bodies' coefficients, exceeds its mu", _widened
+)
+
+
 class PyBullet(EngineLaw):
     """Bullet Physics through PyBullet: the scene stepped with Bullet's impulse solver."""
 
@@ -220,6 +249,28 @@ class PyBullet(EngineLaw):
             "at 1e-4 s and a third (the plastic outcome) at 1e-5 s; the elastic rocking block "
             "keeps 88 %, its box landing on one point of its contact manifold, off its plane",
             (("three_ball_chain", "default"),),
+        ),
+        Claim(
+            "energy_gain",
+            option("settings", "tuned") & coupled_friction,
+            f"Kane and Levinson 1985; Brogliato 2010, eqs. (6)-(9); {_SOLVER}",
+            "tuned, each step restitutes the contact by Newton's rule with Coulomb's friction on "
+            "the slip after the step, at one contact Whittaker's law (Brogliato 2010, eq. 8): "
+            "where inertia couples the normal and tangential directions the slip can reverse "
+            "and the impact end with more energy than it began with (Kane and Levinson's "
+            "paradox; the rod of falling_rod's example 'energy gain', +1.5 %, Moreau's answer to "
+            "1e-12)",
+        ),
+        Claim(
+            "friction_cone",
+            option("settings", "default") & widened_cone,
+            f"{_QUICKSTART}: changeDynamics (restitution and lateralFriction are a body's); "
+            f"{_COMBINED}",
+            "at its defaults each body carries the scene's coefficients, and Bullet gives a "
+            "contact the product of its two bodies' (e1 e2 and mu1 mu2, the friction at most "
+            "10): a contact of e and mu acts with e^2 and mu^2, and where mu > 1 a sliding "
+            "contact's impulse leaves the scene's cone (the sphere grazing a wall at 80 degrees "
+            "with mu = 1.2 and e = 0 slides with |Pt| = 1.44 Pn)",
         ),
     )
     guarantees = (
@@ -321,9 +372,10 @@ class _BulletScene(Scene):
         self.bullet, self.geometry, self.reach = _bullet(), start.geometry, start.reach
         self.client = _client(start.settings)
         # The scene's bodies in the geometry's order, and those it made (the others are planes
-        # the client keeps).
+        # the client keeps); the link that carries each body's shape, -1 for a base.
         self.ids: list[int] = []
         self.made: list[int] = []
+        self.links: dict[int, int] = {}
         try:
             self._build(start, coefficients)
         except BaseException:
@@ -338,16 +390,14 @@ class _BulletScene(Scene):
         self._call("setPhysicsEngineParameter", fixedTimeStep=start.dt)
         for k, body in enumerate(self.geometry.bodies):
             kind = self.geometry.joint(body.name).kind
-            if kind in ("hinge", "slide"):
-                raise NotApplicable(
-                    f"pybullet: the scene's {kind} joint is not built (free, planar and fixed "
-                    "joints are)"
-                )
             position, (w, *q) = poses[k]
             place = {"posObj": list(position), "ornObj": [*q, w]}
             if body.shape == "plane":
                 uid = self._plane(sum(b.shape == "plane" for b in self.geometry.bodies[:k]))
                 self._call("resetBasePositionAndOrientation", uid, **place)
+            elif kind in ("hinge", "slide"):
+                uid = self._jointed(body, poses[k], tuned)
+                self.made.append(uid)
             else:
                 mass = body.mass if kind != "fixed" else 0.0
                 shape = self._shape(body, tuned)
@@ -360,8 +410,41 @@ class _BulletScene(Scene):
                 )
                 self.made.append(uid)
             self.ids.append(uid)
+            self.links.setdefault(uid, -1)
             self._dynamics(uid, body, coefficients[k], velocities[k])
         self._only_declared_pairs()
+
+    def _jointed(self, body: Body, pose: tuple[np.ndarray, tuple[float, ...]], tuned: bool) -> int:
+        """A fixed base without shape and one link, ``body``, on a revolute or prismatic joint.
+
+        The link's frame is the joint's, at the hinge's anchor (the body's centre for a slide),
+        turned as the body; its centre of mass and its shape sit at the body's centre.
+        """
+        joint = self.geometry.joint(body.name)
+        position, (w, *q) = pose
+        R = rotation_matrix((w, *q))
+        origin = np.asarray(joint.anchor if joint.kind == "hinge" else position)
+        offset = R.T @ (np.asarray(position) - origin)
+        kinds = {"hinge": self.bullet.JOINT_REVOLUTE, "slide": self.bullet.JOINT_PRISMATIC}
+        uid = self._call(
+            "createMultiBody",
+            0.0,
+            -1,
+            basePosition=origin.tolist(),
+            linkMasses=[body.mass],
+            linkCollisionShapeIndices=[self._shape(body, tuned, offset)],
+            linkVisualShapeIndices=[-1],
+            linkPositions=[[0.0, 0.0, 0.0]],
+            linkOrientations=[[*q, w]],
+            linkInertialFramePositions=[offset.tolist()],
+            linkInertialFrameOrientations=[[0.0, 0.0, 0.0, 1.0]],
+            linkParentIndices=[0],
+            linkJointTypes=[kinds[joint.kind]],
+            linkJointAxis=[(R.T @ np.asarray(joint.axis)).tolist()],
+        )
+        self._call("setJointMotorControl2", uid, 0, self.bullet.VELOCITY_CONTROL, force=0.0)
+        self.links[uid] = 0
+        return uid
 
     def _plane(self, number: int) -> int:
         """The client's plane body ``number``, made when the client has no such plane yet."""
@@ -374,35 +457,45 @@ class _BulletScene(Scene):
     def _dynamics(
         self, uid: int, body: Body, coefficients: tuple[float, float], velocity: np.ndarray
     ) -> None:
-        """Coefficients, no damping, inertia and velocity of a body (fixed ones keep still)."""
-        moving = self.geometry.moving(body.name)
+        """Coefficients, no damping, inertia and velocity of a body (fixed ones keep still).
+
+        A link on a joint takes the joint's rate that gives it its velocity.
+        """
+        moving, link = self.geometry.moving(body.name), self.links[uid]
         restitution, friction = coefficients
         self._call(
             "changeDynamics",
             uid,
-            -1,
+            link,
             restitution=restitution,
             lateralFriction=friction,
             linearDamping=0.0,
             angularDamping=0.0,
+            jointDamping=0.0,
             **({"localInertiaDiagonal": list(body.inertia)} if moving else {}),
         )
-        if moving:
+        if link >= 0:
+            joint = self.geometry.joint(body.name)
+            along = velocity[3:] if joint.kind == "hinge" else velocity[:3]
+            self._call("resetJointState", uid, link, 0.0, float(along @ joint.axis))
+        elif moving:
             self._call("resetBaseVelocity", uid, *np.split(velocity, 2))
 
-    def _shape(self, body: Body, tuned: bool) -> int:
+    def _shape(self, body: Body, tuned: bool, offset: np.ndarray | None = None) -> int:
         """The collision shape of ``body`` (a tuned box: spheres at its contact points).
 
-        Made once per description in the client (`_client`).
+        ``offset`` moves it in the frame it is attached to (a link's frame at its joint). Made
+        once per description in the client (`_client`).
         """
+        shift = np.zeros(3) if offset is None else offset
         if body.shape == "box" and tuned:
-            key: tuple = ("corners", *self._corners(body))
+            key: tuple = ("corners", *self._corners(body, shift))
             make = ("createCollisionShapeArray", [self.bullet.GEOM_SPHERE] * (len(key) // 2))
             arguments = {"radii": list(key[1::2]), "collisionFramePositions": list(key[2::2])}
         elif body.shape in SIZES:
-            key = (body.shape, body.size)
+            key = (body.shape, body.size, *shift.tolist())
             make = ("createCollisionShape", getattr(self.bullet, f"GEOM_{body.shape.upper()}"))
-            arguments = SIZES[body.shape](body.size)
+            arguments = {**SIZES[body.shape](body.size), "collisionFramePosition": list(shift)}
         else:
             raise NotApplicable(f"pybullet: Bullet has no {body.shape} shape")
         shapes = self.client.shapes
@@ -410,16 +503,16 @@ class _BulletScene(Scene):
             shapes[key] = self._call(*make, **arguments)
         return shapes[key]
 
-    def _corners(self, body: Body) -> list:
-        """Radius and position (body frame) of a small sphere at each contact point of ``body``.
+    def _corners(self, body: Body, shift: np.ndarray) -> list:
+        """Radius and position of a small sphere at each contact point of ``body``.
 
-        `corner`'s, flattened.
+        `corner`'s, flattened; the positions in the body's frame, moved by ``shift``.
         """
         corners = []
         for pair in self.geometry.pairs:
             if body.name in (pair.a, pair.b):
                 radius, local = corner(body, pair)
-                corners += [radius, tuple(local.tolist())]
+                corners += [radius, tuple((local + shift).tolist())]
         return corners
 
     def _only_declared_pairs(self) -> None:
@@ -433,10 +526,11 @@ class _BulletScene(Scene):
             frozenset((self.ids[index[p.a]], self.ids[index[p.b]])) for p in self.geometry.pairs
         }
         every = self.ids + [uid for uid in self.client.planes if uid not in self.ids]
+        links = [self.links.get(uid, -1) for uid in every]
         for i, first in enumerate(every):
-            for second in every[:i]:
+            for k, second in enumerate(every[:i]):
                 wanted = int(frozenset((first, second)) in declared)
-                self._call("setCollisionFilterPair", first, second, -1, -1, wanted)
+                self._call("setCollisionFilterPair", first, second, links[i], links[k], wanted)
 
     def step(self) -> tuple[list[Force], np.ndarray]:
         """One stepSimulation: the forces of its contact points, and the bodies' velocities."""
@@ -448,10 +542,23 @@ class _BulletScene(Scene):
             force = point[9] * normal + point[10] * np.asarray(point[11])
             force = force + point[12] * np.asarray(point[13])
             forces.append(Force(names[point[1]], names[point[2]], (on_a + on_b) / 2, force))
-        velocities = np.array(
-            [np.concatenate(self._call("getBaseVelocity", uid)) for uid in self.ids]
-        )
-        return forces, velocities
+        return forces, np.array([self._velocity(k, uid) for k, uid in enumerate(self.ids)])
+
+    def _velocity(self, k: int, uid: int) -> np.ndarray:
+        """The velocity of body k's centre of mass and its angular velocity (6,).
+
+        A link's from its joint's rate (getLinkState reports in single precision).
+        """
+        link = self.links[uid]
+        if link < 0:
+            return np.concatenate(self._call("getBaseVelocity", uid))
+        joint = self.geometry.joint(self.geometry.bodies[k].name)
+        axis, rate = np.asarray(joint.axis), self._call("getJointState", uid, link)[1]
+        if joint.kind == "slide":
+            return np.concatenate([rate * axis, np.zeros(3)])
+        centre = self._call("getLinkState", uid, link, computeForwardKinematics=1)[0]
+        arm = np.asarray(centre) - np.asarray(joint.anchor)
+        return np.concatenate([rate * np.cross(axis, arm), rate * axis])
 
     def distances(self) -> np.ndarray:
         """Bullet's closest points of each two bodies that touch, each to its nearest pair."""
@@ -467,7 +574,7 @@ class _BulletScene(Scene):
         """Remove the bodies the scene made from the client, for the next solve."""
         for uid in self.made:
             self._call("removeBody", uid)
-        self.ids, self.made = [], []
+        self.ids, self.made, self.links = [], [], {}
 
 
 LAWS.register(PyBullet())

@@ -109,6 +109,17 @@ def _thinning(left: dict[str, tuple[int, int | None]]) -> list[str]:
     ]
 
 
+def _engines_left(cases: Sequence[Case]) -> list[str]:
+    """A note on the scenes whose engine cells the quick report leaves to the full one."""
+    names = [f"`{case.name}`" for case in cases if not case.quick_engines]
+    if not names:
+        return []
+    return [
+        f"the engines step {', '.join(names)} in the full report only (`lawbench report "
+        "--full`): in the quick one their cells on those scenes would add some ten seconds"
+    ]
+
+
 def _measured_less(studies: list[Study]) -> list[str]:
     """A note on the studies that measure the costly laws' cells for fewer quantities."""
     if not studies:
@@ -183,6 +194,8 @@ class Context:
             else:
                 self.left_out[study.name] = "none of its laws and scenes is selected"
         self.notes += _thinning(thinned)
+        if not full:
+            self.notes += _engines_left(self.cases)
         self.notes += _measured_less([s for s in self.studies if s.costly_measures is not None])
         if not full:
             shutil.rmtree(self.out / "runs", ignore_errors=True)
