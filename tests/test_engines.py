@@ -285,6 +285,25 @@ def test_the_engine_s_contact_jacobians_are_a_cube_toss_s(engine, toss):
     assert_engine_columns(engine, impact.problem)
 
 
+def test_every_ellipse_bounce_is_its_geometry_s():
+    """The ellipse bounces (Fazeli et al., ICRA 2017) carry their geometry: the ellipse at the
+    angle of the source's contact, the plate the plane through its lowest point. Every kept
+    bounce's problem is that geometry's linear algebra."""
+    impacts = MEASUREMENTS.get("ellipse").impacts
+    assert len(impacts) == 1718
+    for impact in impacts:
+        assert _base.geometry_mismatch(impact.problem.geometry, impact.problem) is None
+
+
+@pytest.mark.parametrize("bounce", [0, 267])
+@pytest.mark.parametrize("engine", list(COLUMNS))
+def test_the_engine_s_contact_jacobians_are_an_ellipse_bounce_s(engine, bounce):
+    """The ellipse near upright (bounce 0) and touching 10 mm off its centre (bounce 267): each
+    engine finds the contact at the ellipse's lowest point, the problem's."""
+    impact = next(i for i in MEASUREMENTS.get("ellipse").impacts if i.index == bounce)
+    assert_engine_columns(engine, impact.problem)
+
+
 @pytest.mark.parametrize(
     ("field", "change", "message"),
     [
