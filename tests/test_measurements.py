@@ -20,6 +20,7 @@ import pytest
 
 from lawbench.core.errors import UnknownName
 from lawbench.core.trial import make_trial
+from lawbench.laws.engines._base import geometry_mismatch
 from lawbench.measurements import MEASUREMENTS, MeasuredImpact, consistency, residuals
 from lawbench.measurements.convert import ellipse as convert_ellipse
 from lawbench.measurements.impacts import read_data, training_mask
@@ -51,6 +52,17 @@ def test_the_ellipse_inertia_from_its_published_mass_and_axes():
     moment = ellipse.MASS * (dv[:, 1] * arms[:, 0] + dv[:, 0] * arms[:, 1])
     implied = moment @ dv[:, 2] / (dv[:, 2] @ dv[:, 2])
     assert 0.7 * ellipse.INERTIA < implied < ellipse.INERTIA
+
+
+@pytest.mark.parametrize(("name", "count"), [("cube", 348), ("ellipse", 1718)])
+def test_every_impact_of_a_set_with_geometry_is_its_geometry_s(name, count):
+    """The cube tosses carry the box at its measured pose on the table's plane through its lowest
+    touching vertex; the ellipse bounces the ellipse at the angle of the source's contact, on the
+    plate through its lowest point. Every kept impact's problem is its geometry's."""
+    impacts = MEASUREMENTS.get(name).impacts
+    assert len(impacts) == count
+    for impact in impacts:
+        assert geometry_mismatch(impact.problem.geometry, impact.problem) is None
 
 
 @pytest.mark.parametrize("angle", [-1.5, -0.7, 0.0, 0.3, 1.2])
