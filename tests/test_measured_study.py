@@ -226,3 +226,19 @@ def test_an_engine_is_fitted_through_the_set_s_geometry():
     row = study.table.set_index("law").loc["pybullet"]
     assert row["e"] == pytest.approx(0.4, abs=1e-3) and row["mu"] == pytest.approx(0.3, abs=1e-3)
     assert row["median_error"] < 1e-3 and row["refused"] == 0
+
+
+def test_an_engine_is_fitted_back_on_ellipse_bounces():
+    """The ellipse bounces carry their geometry too: a set made by MuJoCo at its tuned
+    settings, e = 0.6 and mu = 0.1 (the ellipse slips through most bounces), on ten bounces is
+    fitted back to them."""
+    pytest.importorskip("mujoco")
+    law = LAWS.get("mujoco")
+    ten = evenly(ELLIPSE.impacts, 10)
+    velocities, failures = predict(law, ten, {"e": 0.6, "mu": 0.1}, study_options(law))
+    assert not failures
+    made = [dataclasses.replace(i, v_after=v) for i, v in zip(ten, velocities, strict=True)]
+    study = measured_study(small_set(made[:5], made[5:]), ["mujoco"])
+    row = study.table.set_index("law").loc["mujoco"]
+    assert row["e"] == pytest.approx(0.6, abs=1e-3) and row["mu"] == pytest.approx(0.1, abs=1e-3)
+    assert row["median_error"] < 1e-3 and row["refused"] == 0

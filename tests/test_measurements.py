@@ -20,7 +20,9 @@ import pytest
 
 from lawbench.core.errors import UnknownName
 from lawbench.core.trial import make_trial
+from lawbench.laws.engines._base import geometry_mismatch
 from lawbench.measurements import MEASUREMENTS, MeasuredImpact, consistency, residuals
+from lawbench.measurements.convert import ellipse as convert_ellipse
 from lawbench.measurements.impacts import read_data, training_mask
 from lawbench.measurements.sets import ellipse, kharaz
 
@@ -44,13 +46,39 @@ def test_the_ellipse_inertia_from_its_published_mass_and_axes():
     """I = m (a^2 + b^2) / 4 of a uniform 70 x 50 mm plate of 36.4 g; the spin changes the
     bounces measured imply, by least squares on the moment of the impulses, lie within 30 %."""
     assert ellipse.INERTIA == pytest.approx(0.0364 * (0.035**2 + 0.025**2) / 4)
-    data, kept = read_data("ellipse"), ~read_data("ellipse")["flags"].any(axis=1)
-    dv = data["v_after"][kept] - data["v_before"][kept]
-    moment = ellipse.MASS * (
-        dv[:, 1] * data["normal"][kept, 2] + dv[:, 0] * data["tangent"][kept, 2]
-    )
+    impacts = MEASUREMENTS["ellipse"].impacts
+    dv = np.array([i.dv for i in impacts])
+    arms = np.array([(i.problem.Wn[2, 0], i.problem.Wt[2, 0]) for i in impacts])
+    moment = ellipse.MASS * (dv[:, 1] * arms[:, 0] + dv[:, 0] * arms[:, 1])
     implied = moment @ dv[:, 2] / (dv[:, 2] @ dv[:, 2])
     assert 0.7 * ellipse.INERTIA < implied < ellipse.INERTIA
+
+
+@pytest.mark.parametrize(("name", "count"), [("cube", 348), ("ellipse", 1718)])
+def test_every_impact_of_a_set_with_geometry_is_its_geometry_s(name, count):
+    """The cube tosses carry the box at its measured pose on the table's plane through its lowest
+    touching vertex; the ellipse bounces the ellipse at the angle of the source's contact, on the
+    plate through its lowest point. Every kept impact's problem is its geometry's."""
+    impacts = MEASUREMENTS.get(name).impacts
+    assert len(impacts) == count
+    for impact in impacts:
+        assert geometry_mismatch(impact.problem.geometry, impact.problem) is None
+
+
+@pytest.mark.parametrize("angle", [-1.5, -0.7, 0.0, 0.3, 1.2])
+def test_the_ellipse_touches_at_its_lowest_point_and_the_conversion_finds_its_angle(angle):
+    """The closed-form lowest point lies on the ellipse, below 10^4 of its points turned
+    clockwise by ``angle``; the conversion's search gives the angle back from that point."""
+    a, b = ellipse.SEMI_AXES
+    phi = np.linspace(0.0, 2 * np.pi, 10_000)
+    x, z = a * np.cos(phi), b * np.sin(phi)
+    c, s = math.cos(angle), math.sin(angle)
+    turned = np.column_stack([x * c + z * s, -x * s + z * c])
+    point = np.array(ellipse.lowest_point(angle))
+    assert np.abs(np.hypot(*(turned - point).T)).min() < 1e-5
+    assert point[1] <= turned[:, 1].min() < point[1] + 1e-8
+    found, off = convert_ellipse.contact_angle(point)
+    assert found == pytest.approx(angle, abs=1e-8) and off < 1e-12
 
 
 def test_the_ellipse_tangent_sign_is_the_one_its_velocities_choose():

@@ -87,3 +87,15 @@ def test_the_studies_run_in_workers_on_the_sets_asked_for(tmp_path):
     study = found.studies["kharaz"]
     assert study.table.iloc[0]["law"] == "whittaker"
     assert set(found.kharaz["law"]) == {"whittaker"}  # the frictional laws asked for
+
+
+def test_the_quick_report_leaves_the_engines_fits_to_the_full_one():
+    """Each set's tasks hold every engine alone in the full report and none in the quick one:
+    tuned, an engine steps each trial of a fit for up to tenths of a second."""
+    engines = {name for name in LAWS.names() if LAWS.get(name).engine}
+    for name in ("ellipse", "cube", "kharaz"):
+        chosen = MEASUREMENTS.get(name)
+        quick = {law for _, laws, _ in measured.tasks(chosen, LAWS.names(), True) for law in laws}
+        full = [laws for _, laws, _ in measured.tasks(chosen, LAWS.names(), False)]
+        assert quick and not quick & engines
+        assert all([engine] in full for engine in engines)

@@ -33,15 +33,17 @@ Settings (option ``settings``):
   mean). Bullet then
   multiplies the two bodies' coefficients: a contact of restitution e and friction mu acts with
   e^2 and mu^2. Bullet's box-plane contact manifold gains one point per step, so a box lands on
-  one corner point first.
+  one corner point first. Bullet has no ellipsoid: an ellipsoid is the convex hull of points of
+  its surface (`ellipsoid_points`).
 - ``tuned``, as rigid and faithful to e and mu as Bullet allows: contactSlop 0 (the slop lets a
   closed contact approach at slop/dt, swallowing the restitution as the step shrinks), erp,
   contactERP and frictionERP 0 (the error reduction pushes penetrating bodies apart with
   velocity, which creates energy), restitutionVelocityThreshold 0 (restitution at every
   speed), 1000 solver iterations with solverResidualThreshold 0 (the solver stops at neither),
   a step of 1e-4 s, and per-body coefficients whose products are the scene's (where a fixed body
-  takes part, it keeps 1 and the moving body the scene's value); a box touches through small
-  spheres (radius `CORNER_RADIUS` of its smallest half-extent) at its declared contact points.
+  takes part, it keeps 1 and the moving body the scene's value); a box or an ellipsoid touches
+  through small spheres (radius `CORNER_RADIUS` of its smallest size) at its declared contact
+  points.
   Bullet's restitution is then Moreau's per-contact rule on each step's velocities,
   ``0 <= un+ + e un- _|_ Pn >= 0``, with Coulomb's friction on the impulses in its circular
   cone (enableConeFriction, on by default; off, a pyramid lets |Pt| reach sqrt(2) mu Pn).
@@ -113,6 +115,10 @@ TUNED = {
 # Bullet clamps the product of two frictions to this.
 MAX_FRICTION = 10.0
 _NO_FORCE = np.zeros(3)
+# Bullet has no ellipsoid: at the default settings it is the convex hull of points of its
+# surface, on PARALLELS parallels (an odd number: the equator is one) of MERIDIANS points.
+PARALLELS = 5
+MERIDIANS = 128
 # The arguments of createCollisionShape for each shape Bullet has, from the geometry's sizes.
 SIZES = {
     "sphere": lambda size: {"radius": size[0]},
@@ -121,6 +127,22 @@ SIZES = {
     "cylinder": lambda size: {"radius": size[0], "height": 2 * size[1]},
     "plane": lambda size: {},
 }
+
+
+def ellipsoid_points(size: Sequence[float]) -> list[list[float]]:
+    """Points of the surface of the ellipsoid of semi-axes ``size``, for Bullet's convex hull.
+
+    `MERIDIANS` points on each of `PARALLELS` parallels about the body's y axis, the equator
+    (the body's x-z section) among them, and the two poles.
+    """
+    a, b, c = size
+    points = [[0.0, -b, 0.0], [0.0, b, 0.0]]
+    for latitude in np.linspace(-np.pi / 2, np.pi / 2, PARALLELS + 2)[1:-1]:
+        for longitude in np.linspace(0.0, 2 * np.pi, MERIDIANS, endpoint=False):
+            ring = math.cos(latitude)
+            x, z = a * ring * math.cos(longitude), c * ring * math.sin(longitude)
+            points.append([x, b * math.sin(latitude), z])
+    return points
 
 
 @functools.cache
@@ -211,7 +233,7 @@ class PyBullet(EngineLaw):
         "multiplies the two bodies')",
         "contactSlop, erp, contactERP, frictionERP and restitutionVelocityThreshold 0, 1000 "
         "solver iterations, step 1e-4 s, per-body coefficients whose products are the scene's, "
-        "boxes touching through small spheres at their contact points",
+        "boxes and ellipsoids touching through small spheres at their contact points",
     )
     findings = (
         RIGID_DISPERSION,
@@ -482,16 +504,23 @@ class _BulletScene(Scene):
             self._call("resetBaseVelocity", uid, *np.split(velocity, 2))
 
     def _shape(self, body: Body, tuned: bool, offset: np.ndarray | None = None) -> int:
-        """The collision shape of ``body`` (a tuned box: spheres at its contact points).
+        """The collision shape of ``body`` (a tuned box or ellipsoid: spheres at its contacts).
 
         ``offset`` moves it in the frame it is attached to (a link's frame at its joint). Made
         once per description in the client (`_client`).
         """
         shift = np.zeros(3) if offset is None else offset
-        if body.shape == "box" and tuned:
+        if body.shape in ("box", "ellipsoid") and tuned:
             key: tuple = ("corners", *self._corners(body, shift))
             make = ("createCollisionShapeArray", [self.bullet.GEOM_SPHERE] * (len(key) // 2))
             arguments = {"radii": list(key[1::2]), "collisionFramePositions": list(key[2::2])}
+        elif body.shape == "ellipsoid":
+            key = (body.shape, body.size, *shift.tolist())
+            make = ("createCollisionShape", self.bullet.GEOM_MESH)
+            arguments = {
+                "vertices": ellipsoid_points(body.size),
+                "collisionFramePosition": list(shift),
+            }
         elif body.shape in SIZES:
             key = (body.shape, body.size, *shift.tolist())
             make = ("createCollisionShape", getattr(self.bullet, f"GEOM_{body.shape.upper()}"))
