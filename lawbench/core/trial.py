@@ -173,10 +173,12 @@ def make_trial(
     settings : mapping, optional
         Settings of the checks that solve again, carried by the trial.
     max_seconds : float, optional
-        A wall-clock bound on the whole call. Whether given or not, the call is stopped from
-        outside (`lawbench.core.guards.alarm`) once the law's own ``max_seconds`` and
-        `OUTSIDE_GRACE_S` have passed, whatever the law does, so that a law that ignores its
-        budget still ends with `BudgetExceeded`.
+        A wall-clock bound on building the problem, and another on solving it. Whether given or
+        not, each is stopped from outside (`lawbench.core.guards.alarm`) once the law's own
+        ``max_seconds`` and `OUTSIDE_GRACE_S` have passed, whatever the law does, so that a law
+        that ignores its budget still ends with `BudgetExceeded`. Between the two, the law's
+        one-time work of the process (`Law.prepare`: compiling its kernels) is no part of
+        either bound, nor of the solve's budget.
     judged : bool
         Whether an impact's answer that breaks a promise raises `SolverFailure` (the judges of
         `PROMISES`, run after the solve and outside its bound). False returns it as it is, for
@@ -198,8 +200,11 @@ def make_trial(
     law = _law(law)
     options = _options(options)
     watch_interrupts()
-    with alarm(_outside_bound(law, options, max_seconds)):
+    bound = _outside_bound(law, options, max_seconds)
+    with alarm(bound):
         problem, scene, full, facts = _given(source, params, transform)
+    law.prepare(problem)
+    with alarm(bound):
         outcome = _answer(law, problem, options)
     values = outcome.diagnostics["options"]
     trial = Trial(law, scene, full, values, problem, outcome, dict(settings or {}), facts)
