@@ -10,7 +10,8 @@ modules. They read the answer's velocities, never what a law says about itself: 
 are ``v @ M @ v / 2`` of the problem's ``v`` and the answer's ``v_plus``, and the impulses are
 judged only as a decomposition of the velocity change, ``Wn Pn + Wt Pt = M (v+ - v-)``
 (`Law.resolve` refuses an answer whose impulses are not one; a trial made otherwise fails the
-impulse checks).
+impulse checks). `broken_promise` is the judge this module registers with the one way into a
+solve (`lawbench.core.trial.PROMISES`): an answer with a numerical failure is refused there.
 """
 
 from __future__ import annotations
