@@ -7,6 +7,7 @@ velocity, ``K ∋ P _|_ (un + mu |ut|, ut) ∈ K*``.
 """
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -201,3 +202,41 @@ def test_plain_python_runs_the_same_sweeps():
     assert done.returncode == 0, done.stderr
     plain = np.array(json.loads(done.stdout))
     np.testing.assert_allclose(plain, solve_nsgs(W, q, mu, dim, 1e-12).P, rtol=0, atol=1e-14)
+
+
+def test_a_solve_gives_the_kernels_the_types_they_were_compiled_for():
+    """`compiled` compiles each kernel for the types a solve gives it (a problem's read-only
+    arrays made writable): a solve compiles nothing, so no solve's budget pays for it."""
+    numba = pytest.importorskip("numba")
+    from lawbench.numerics import gauss_seidel
+
+    assert gauss_seidel.compiled()
+    kernels = [getattr(gauss_seidel, name) for name in gauss_seidel._KERNELS]
+    assert all(isinstance(kernel, numba.core.registry.CPUDispatcher) for kernel in kernels)
+    before = [list(kernel.signatures) for kernel in kernels]
+    assert all(before[gauss_seidel._KERNELS.index(name)] for name in ("_sweep", "_in_a_state"))
+    for name in FRICTIONAL:
+        MOREAU.resolve(with_friction(name, 0.3), method="nsgs")
+    assert [list(kernel.signatures) for kernel in kernels] == before
+
+
+COLD_SOLVE = """
+import lawbench
+outcome = lawbench.solve("moreau", "sphere_wall", {"max_seconds": 5})
+print(outcome.status, outcome.diagnostics["formulation"])
+"""
+
+
+@pytest.mark.slow
+def test_a_cold_compile_is_no_part_of_a_solve_budget(tmp_path):
+    """With numba's cache empty, compiling the kernels (30 s and more on one core) is a cost of
+    the process, paid before the solve's budget starts: a 5 s solve that sweeps ends ok."""
+    pytest.importorskip("numba")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    done = subprocess.run(
+        [sys.executable, "-c", COLD_SOLVE], env=env, capture_output=True, text=True, timeout=900
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split()[0] == "ok"
+    assert "(numba)" in done.stdout
+    assert any(tmp_path.rglob("*.nbi")), "the kernels were not compiled in this process"

@@ -4,7 +4,8 @@ FCLIB files valid in form but hostile (an empty ``spacedim``, ``mu`` stored as a
 form whose ``f`` is shorter than ``M``, a matrix that claims a billion rows, a ``W`` of 1e-300,
 an indefinite or skew ``W``, ``mu = 1e300``); the standard streams closed, broken, full or
 narrow; outputs on a full disk, under ``/sys`` or behind a symlink; resuming onto a table no run
-wrote; run files with a negative seed, a fractional count or bad continuity sizes.
+wrote; run files with a negative seed, a fractional count or bad continuity sizes, options of a law
+that has no cell in their grid, a check named twice.
 """
 
 import errno
@@ -177,6 +178,30 @@ def test_run_files_refuse_a_negative_seed_a_fractional_count_and_bad_sizes():
         RunSpec.from_dict({"grid": [{**grid[0], "params": {"e": {"range": [0, 1, 2.5]}}}]})
     with pytest.raises(lawbench.InvalidProblem, match="unknown key 'sizes'"):
         RunSpec.from_dict({"grid": grid, "sizes": [1]})
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        (
+            {"grid": [{"laws": ["newton"], "options": {"moreau": {"max_seconds": [5.0]}}}]},
+            r"grid\[0\]\.options\.moreau: 'moreau' has no cell",
+        ),
+        (
+            {"grid": [{"cases": ["two_balls_wall"], "options": {"brach": {"max_seconds": [5]}}}]},
+            r"grid\[0\]\.options\.brach: 'brach' has no cell",
+        ),
+        (
+            {"grid": [{"laws": ["newton"]}], "checks": ["momentum", "admissible", "momentum"]},
+            "key 'checks' names the check 'momentum' twice",
+        ),
+    ],
+    ids=["law not listed", "law that treats no case", "check twice"],
+)
+def test_run_files_refuse_options_no_cell_uses_and_a_check_named_twice(spec, message):
+    """Both were taken: the options were silently ignored, and the check was run twice."""
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        RunSpec.from_dict(spec).rows()
 
 
 @pytest.mark.parametrize(

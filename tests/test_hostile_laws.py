@@ -371,15 +371,16 @@ def test_check_and_run_stop_a_law_that_sleeps(hostile_env, tmp_path):
 
 
 def test_an_answer_that_breaks_a_promise_is_a_solver_failure_never_ok():
-    """A contact left approaching (a promise of every law) ends ``lawbench solve``, exit 4."""
-    from lawbench.views.cli.solve import _refuse_broken_promises
+    """A contact left approaching (a promise of every law) is refused by the one way into a
+    solve, for `lawbench.solve` as for ``lawbench solve`` (exit 4); `run_checks` classes it."""
 
     def pulls(self, problem, options):
         return lawbench.Outcome.from_impulses(problem, np.array([-1.0]))
 
-    trial = lawbench.evaluate(broken(pulls), ball())
+    law = broken(pulls)
     with pytest.raises(SolverFailure, match="admissible fails where it must hold"):
-        _refuse_broken_promises(trial, run_checks(trial))
+        lawbench.solve(law, ball())
+    assert str(run_checks(law, ball())["admissible"].verdict) == "numerical failure"
 
 
 FIRST_SOLVE_STOPPED = """
@@ -387,13 +388,15 @@ import time
 
 import lawbench
 from lawbench.core.errors import BudgetExceeded
-from lawbench.core.trial import make_trial
+from lawbench.core.guards import alarm
 
-lawbench.LAWS.get("moreau")
+moreau = lawbench.LAWS.get("moreau")
+problem = lawbench.CASES.get("sphere_wall").build()
 for seconds in (0.02, 0.05, 0.1):
     start = time.monotonic()
     try:
-        make_trial("moreau", "sphere_wall", max_seconds=seconds)
+        with alarm(seconds):
+            moreau.resolve(problem)
     except BudgetExceeded:
         continue
     if time.monotonic() - start > seconds + 0.05:
@@ -404,10 +407,11 @@ print(lawbench.solve("moreau", "sphere_wall").v_plus.tolist())
 
 def test_a_first_solve_stopped_while_numba_loads_leaves_the_process_able_to_solve():
     """The first frictional solve at one contact imports numba and loads Gauss-Seidel's
-    compiled kernel: stopped there by the wall-clock guard, numba was left half-imported (every
-    later solve an AttributeError or KeyError), or the stop was swallowed and the answer came
-    past its bound. The guard now rings once numba is whole: each stopped solve is a budget,
-    and the next one answers."""
+    compiled kernel, unless the one way into a solve prepared them before its bound (a law's
+    own resolve under an alarm does not): stopped there by the alarm, numba was left
+    half-imported (every later solve an AttributeError or KeyError), or the stop was swallowed
+    and the answer came past its bound. The alarm now rings once numba is whole: each stopped
+    solve is a budget, and the next one answers."""
     done = subprocess.run(
         [sys.executable, "-c", FIRST_SOLVE_STOPPED], capture_output=True, text=True, timeout=300
     )

@@ -3,15 +3,20 @@
 The trace records every function of lawbench that a command calls, with `sys.setprofile`,
 leaving out the code that runs while a module is imported (a module's top level and what it
 calls). It shows the path a scene takes into the solver, how often each parameter is checked,
-and how many of lawbench's modules a small command involves.
+and how many of lawbench's modules a small command involves. The one way decides for every
+caller whether an answer may be shown: `lawbench.solve` refuses the answers ``lawbench solve``
+refuses, those the checks call numerical failures.
 """
 
 import collections
 import sys
 from types import FrameType
 
+import numpy as np
 import pytest
 
+import lawbench
+from lawbench.core.verdicts import Verdict
 from lawbench.views.cli import main
 
 SOLVE = ["solve", "moreau", "three_ball_chain", "--set", "e=0.5"]
@@ -86,3 +91,61 @@ def test_a_small_solve_involves_few_modules(solve_trace, capsys):
     capsys.readouterr()
     modules = sorted({module for module, _ in calls})
     assert len(modules) <= MAX_MODULES, modules
+
+
+def granular(seed: int) -> lawbench.ImpactProblem:
+    """Up to three point bodies in space with more frictional contacts than coordinates.
+
+    Each contact joins two bodies, or a body and the ground, along a random normal; every
+    third seed repeats some contacts. The contact Jacobian is rank-deficient, as in FCLIB's
+    granular packings.
+    """
+    rng = np.random.default_rng(seed)
+    bodies = int(rng.integers(1, 4))
+    m, n = int(rng.integers(2, 3 * bodies + 4)), 3 * bodies
+    Wn, Wt = np.zeros((n, m)), np.zeros((n, 2 * m))
+    for j in range(m):
+        normal = rng.normal(size=3)
+        normal /= np.linalg.norm(normal)
+        along = rng.normal(size=3)
+        t1 = along - along.dot(normal) * normal
+        t1 /= np.linalg.norm(t1)
+        frame = np.stack([normal, t1, np.cross(normal, t1)])
+        if seed % 3 == 0 and j > 0 and rng.random() < 0.5:
+            Wn[:, j], Wt[:, 2 * j : 2 * j + 2] = Wn[:, j - 1], Wt[:, 2 * j - 2 : 2 * j]
+            continue
+        first, second = int(rng.integers(bodies)), int(rng.integers(-1, bodies))
+        for body, sign in ((first, 1.0), (second, -1.0)):
+            if body >= 0 and not (body == first and sign < 0):
+                rows = slice(3 * body, 3 * body + 3)
+                Wn[rows, j] += sign * frame[0]
+                Wt[rows, 2 * j : 2 * j + 2] += sign * frame[1:].T
+    masses = 10.0 ** rng.uniform(-4.5, 4.5, bodies) if seed % 2 else np.ones(bodies)
+    v = rng.normal(size=n)
+    mu = rng.choice([0.0, 0.1, 0.5, 1.0, 3.0], size=m)
+    e = rng.choice([0.0, 0.5, 1.0], size=m)
+    return lawbench.ImpactProblem.from_arrays(np.diag(np.repeat(masses, 3)), Wn, v, Wt, e=e, mu=mu)
+
+
+# Seeds of `granular` where Moreau's Gauss-Seidel answer leaves a contact approaching beyond the
+# checks' tolerance and within the law's own: `lawbench.solve` called it ok.
+REFUSED = [39, 57]
+
+
+@pytest.mark.parametrize("seed", REFUSED)
+def test_the_api_refuses_the_answers_the_command_line_refuses(seed, tmp_path, capsys):
+    problem, options = granular(seed), {"method": "nsgs"}
+    verdicts = lawbench.run_checks("moreau", problem, options)
+    failed = [
+        name for name, result in verdicts.items() if result.verdict == Verdict.NUMERICAL_FAILURE
+    ]
+    assert failed, "the checks find no numerical failure: the input no longer disagrees"
+    with pytest.raises(lawbench.SolverFailure, match=f"moreau: {failed[0]} fails") as raised:
+        lawbench.solve("moreau", problem, options)
+    with pytest.raises(lawbench.SolverFailure, match=f"moreau: {failed[0]} fails"):
+        lawbench.evaluate("moreau", problem, options)
+    lawbench.save_problem(problem, tmp_path / "problem.json")
+    capsys.readouterr()
+    argv = ["solve", "moreau", "--problem", str(tmp_path / "problem.json")]
+    assert main([*argv, "--option", "method=nsgs"]) == 4
+    assert str(raised.value) in capsys.readouterr().err

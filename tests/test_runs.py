@@ -1,5 +1,6 @@
 """Run specifications, the executor and its guard, records, transforms, chunks and resuming."""
 
+import functools
 import math
 import time
 
@@ -225,6 +226,15 @@ def test_a_task_is_timed_from_when_its_worker_begins_it():
     with Guard(workers=1, budget_s=30.0) as guard:
         result = guard.result(guard.submit(abs, SlowToLoad(3.0), budget=1.0))
     assert (result.status, result.value) == ("ok", 3.0)
+
+
+def test_what_a_task_needs_done_once_in_its_process_is_not_its_seconds():
+    """A law's preparation (compiling kernels) runs in the worker before the task is timed."""
+    with Guard(workers=1, budget_s=30.0) as guard:
+        done = guard.submit(abs, -2.0, budget=1.0, before=functools.partial(time.sleep, 3.0))
+        result = guard.result(done)
+    assert (result.status, result.value) == ("ok", 2.0)
+    assert result.seconds < 1.0
 
 
 @pytest.mark.parametrize("executor", ["serial", "processes"])

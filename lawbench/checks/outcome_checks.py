@@ -10,7 +10,8 @@ modules. They read the answer's velocities, never what a law says about itself: 
 are ``v @ M @ v / 2`` of the problem's ``v`` and the answer's ``v_plus``, and the impulses are
 judged only as a decomposition of the velocity change, ``Wn Pn + Wt Pt = M (v+ - v-)``
 (`Law.resolve` refuses an answer whose impulses are not one; a trial made otherwise fails the
-impulse checks).
+impulse checks). `broken_promise` is the judge this module registers with the one way into a
+solve (`lawbench.core.trial.PROMISES`): an answer with a numerical failure is refused there.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from lawbench.core.law import Law
 from lawbench.core.metric import is_sparse
 from lawbench.core.outcome import gap_rates, generalized_impulse
 from lawbench.core.problem import RESTITUTION_FIELDS, ImpactProblem
-from lawbench.core.trial import Trial, evaluate
+from lawbench.core.trial import PROMISES, Trial, make_trial
 from lawbench.core.verdicts import Claim, Verdict
 
 if TYPE_CHECKING:
@@ -221,8 +222,31 @@ def run_checks(
             "with a law, or a trial alone"
         )
     else:
-        trial = evaluate(law, case, options, **params)
-    return CheckResults({name: CHECKS[name](trial) for name in _check_names(checks)})
+        trial = make_trial(law, case, params=params, options=options, judged=False)
+    return CheckResults({name: _checked(trial, name) for name in _check_names(checks)})
+
+
+def _checked(trial: Trial, name: str) -> CheckResult:
+    """The result of check ``name`` on ``trial``, computed once per trial."""
+    if name not in trial.checked:
+        trial.checked[name] = CHECKS[name](trial)
+    return trial.checked[name]
+
+
+def broken_promise(trial: Trial) -> str:
+    """Why the answer of ``trial`` breaks a promise, or '' (the judge of `PROMISES`).
+
+    A promise is broken where a single-solve check is a numerical failure: it fails where a
+    guarantee of the law, or a promise of every law, says it holds.
+    """
+    for name, result in run_checks(trial).items():
+        if result.verdict == Verdict.NUMERICAL_FAILURE:
+            promise = f" ({result.claim.describe()})" if result.claim else ""
+            return f"{trial.law.name}: {name} fails where it must hold{promise}: {result.detail}"
+    return ""
+
+
+PROMISES.append(broken_promise)
 
 
 def _check_names(checks: object) -> list[str]:

@@ -241,6 +241,15 @@ class Law(ABC):
         """The rule for separating contacts under ``options`` (``separating_rule`` by default)."""
         return self.separating_rule
 
+    def prepare(self, problem: object = None) -> None:
+        """Do the one-time work of this process that a solve of ``problem`` needs (None: any).
+
+        Compiling a law's kernels, or loading them from a cache, is a cost of the process, not
+        of a solve: the one way into a solve (`lawbench.core.trial.make_trial`) calls this
+        before the solve's wall-clock bound and budget start, and the study runner before its
+        workers start. Nothing by default.
+        """
+
     def refusal(self, problem: ImpactProblem | ProblemBatch) -> str | None:
         """Why this law cannot treat ``problem`` (a feature its tags do not cover), or None.
 

@@ -7,17 +7,23 @@ problem file as read), checks the parameters once, builds the scene once, applie
 transform (`lawbench.core.transforms`), and solves under the law's budget. The command line,
 the study runner, the checks, the batch API and the bench call it; `solve`, `evaluate` and
 `solve_batch` are its public faces. Everything a check reads is in the trial.
+
+It also decides whether an impact's answer may be shown: an answer that breaks a promise (a check
+that the law, or every law, guarantees fails: a numerical failure) raises `SolverFailure`, for
+the command line and `solve` alike. The judges are registered in `PROMISES` by the checks
+(`lawbench.checks`, which every law's package imports to state its claims); a caller that classes
+every answer itself (the study runner, `run_checks`) asks for the answer as it is.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
 from lawbench.core.case import CASES, Case
 from lawbench.core.contact import ContactProblem, ContactSolution
-from lawbench.core.errors import InvalidProblem
+from lawbench.core.errors import InvalidProblem, SolverFailure
 from lawbench.core.guards import alarm, watch_interrupts
 from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
@@ -57,6 +63,8 @@ class Trial:
     settings: dict[str, Any] = field(default_factory=dict)
     # What was learned while obtaining the problem (a file's form and storage), or None.
     facts: Any = None
+    # The results of the checks run on this trial so far, by name: a check is run once.
+    checked: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def scene(self) -> str:
@@ -71,6 +79,10 @@ def solve(
     **params: Any,
 ) -> Outcome:
     """Solve the impact of a scene, or of a problem given as it is, with ``law``.
+
+    An answer that breaks a promise of the law, or of every law (a check that must hold fails:
+    admissibility, impulse sign, friction cone, momentum, a reference, a guarantee), is never
+    returned: it raises `SolverFailure`, as ``lawbench solve`` exits with status 4.
 
     Parameters
     ----------
@@ -97,7 +109,7 @@ def solve(
     NotApplicable
         The law cannot treat the case.
     SolverFailure
-        The law's numerical method failed.
+        The law's numerical method failed, or its answer breaks a promise.
 
     Examples
     --------
@@ -116,7 +128,8 @@ def evaluate(
 ) -> Trial:
     """Like `solve`, but return the whole `Trial` (complete parameters, problem, outcome).
 
-    The trial is what `run_checks` reads.
+    The trial is what `run_checks` reads. An answer that breaks a promise raises
+    `SolverFailure`, as in `solve`; `run_checks` given a law and a scene shows its verdicts.
 
     Examples
     --------
@@ -128,7 +141,7 @@ def evaluate(
     >>> trial.outcome.v_plus.tolist(), str(lawbench.run_checks(trial)["energy_gain"].verdict)
     ([0.0, 1.0], 'holds')
     """
-    return make_trial(law, case, params=params, options=_options(options))
+    return make_trial(law, case, params=params, options=options)
 
 
 def make_trial(
@@ -140,6 +153,7 @@ def make_trial(
     transform: str = "",
     settings: Mapping[str, Any] | None = None,
     max_seconds: float | None = None,
+    judged: bool = True,
 ) -> Trial:
     """Solve ``source`` with ``law``: the one way into every solve.
 
@@ -159,10 +173,16 @@ def make_trial(
     settings : mapping, optional
         Settings of the checks that solve again, carried by the trial.
     max_seconds : float, optional
-        A wall-clock bound on the whole call. Whether given or not, the call is stopped from
-        outside (`lawbench.core.guards.alarm`) once the law's own ``max_seconds`` and
-        `OUTSIDE_GRACE_S` have passed, whatever the law does, so that a law that ignores its
-        budget still ends with `BudgetExceeded`.
+        A wall-clock bound on building the problem, and another on solving it. Whether given or
+        not, each is stopped from outside (`lawbench.core.guards.alarm`) once the law's own
+        ``max_seconds`` and `OUTSIDE_GRACE_S` have passed, whatever the law does, so that a law
+        that ignores its budget still ends with `BudgetExceeded`. Between the two, the law's
+        one-time work of the process (`Law.prepare`: compiling its kernels) is no part of
+        either bound, nor of the solve's budget.
+    judged : bool
+        Whether an impact's answer that breaks a promise raises `SolverFailure` (the judges of
+        `PROMISES`, run after the solve and outside its bound). False returns it as it is, for
+        a caller that classes every answer with the checks' verdicts.
 
     Returns
     -------
@@ -174,13 +194,31 @@ def make_trial(
         An unknown law, scene, parameter, option or transform, a bad value, or parameters or a
         transform given with a source that takes none.
     NotApplicable, SolverFailure
-        As the law's solve raises them.
+        As the law's solve raises them; `SolverFailure` too for a ``judged`` answer that
+        breaks a promise.
     """
     law = _law(law)
-    options = dict(options or {})
+    options = _options(options)
     watch_interrupts()
-    with alarm(_outside_bound(law, options, max_seconds)):
-        return _trial(law, source, params, options, transform, settings)
+    bound = _outside_bound(law, options, max_seconds)
+    with alarm(bound):
+        problem, scene, full, facts = _given(source, params, transform)
+    law.prepare(problem)
+    with alarm(bound):
+        outcome = _answer(law, problem, options)
+    values = outcome.diagnostics["options"]
+    trial = Trial(law, scene, full, values, problem, outcome, dict(settings or {}), facts)
+    if judged and isinstance(trial.outcome, Outcome):
+        for judge in PROMISES:
+            broken = judge(trial)
+            if broken:
+                raise SolverFailure(broken)
+    return trial
+
+
+# The judges of an impact's answer: each returns why the answer of a trial breaks a promise of
+# its law or of every law, or ''. The checks register theirs (`lawbench.checks`).
+PROMISES: list[Callable[[Trial], str]] = []
 
 
 # Seconds past a law's own ``max_seconds`` before the guard from outside stops it: the law's
@@ -194,15 +232,13 @@ def _outside_bound(law: Law, options: dict[str, Any], max_seconds: float | None)
     return own if max_seconds is None else min(own, max_seconds)
 
 
-def _trial(
-    law: Law,
-    source: Source | ProblemBatch,
-    params: Mapping[str, Any] | None,
-    options: dict[str, Any],
-    transform: str,
-    settings: Mapping[str, Any] | None,
-) -> Trial:
-    """`make_trial`'s steps: check and build once, transform, solve."""
+def _given(
+    source: Source | ProblemBatch, params: Mapping[str, Any] | None, transform: str
+) -> tuple[Any, Case | None, dict[str, Any], Any]:
+    """The problem of ``source``, checked and built once, then transformed.
+
+    With its scene, complete parameters and facts (None, {} and None where not known).
+    """
     facts, scene, full = None, None, {}
     if hasattr(source, "facts"):
         source, facts = source.problem, source.facts
@@ -219,9 +255,7 @@ def _trial(
     if transform:
         problem = _transformed(transform, problem)
         scene, full = None, {}
-    outcome = _answer(law, problem, options)
-    values = outcome.diagnostics["options"]
-    return Trial(law, scene, full, values, problem, outcome, dict(settings or {}), facts)
+    return problem, scene, full, facts
 
 
 def _transformed(transform: str, problem: object) -> ImpactProblem:
@@ -285,7 +319,7 @@ def solve_batch(
     if not isinstance(batch, ProblemBatch):
         _law(law)
         batch = ProblemBatch.from_problems(list(batch))
-    return make_trial(law, batch, options=_options(options)).outcome
+    return make_trial(law, batch, options=options).outcome
 
 
 def _law(law: object) -> Law:

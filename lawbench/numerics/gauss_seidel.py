@@ -41,12 +41,15 @@ or ``max_seconds``. `solve_polished` is the law's solve: the sweeps, then, where
 stationary above ``tol``, Newton's method on the contact states they show
 (`lawbench.numerics.cones.polish`), or a failure that gives ``W``'s rank.
 
-The per-contact kernel and the sweep are compiled by numba at the first solve where it is
-installed (``pip install 'lawbench[fast]'``, `compiled`); the same functions run as plain
-Python without it. numba's import and each call of a compiled kernel (its compilation or
-cache load the first time) run whole (`lawbench.core.guards.held`): stopped half-way by the
-solve's wall-clock alarm, numba fails on every later call in the process; a compiled kernel
-runs no Python, where the alarm's handler cannot run anyway.
+The per-contact kernel and the sweep are compiled by numba where it is installed
+(``pip install 'lawbench[fast]'``, `compiled`); the same functions run as plain Python without
+it. The compilation (or its load from numba's cache) is a one-time cost of the process, not of a
+solve: Moreau's law asks for it before a solve's budget and wall-clock bound start
+(`lawbench.core.law.Law.prepare`), and the study runner before its workers start. numba's
+import, the compilation and each call of a compiled kernel run whole
+(`lawbench.core.guards.held`): stopped half-way by a wall-clock alarm, numba fails on every
+later call in the process; a compiled kernel runs no Python, where the alarm's handler cannot
+run anyway.
 ``W`` may be dense or scipy.sparse: it is held in compressed rows, so a sweep costs time
 proportional to its non-zero entries.
 """
@@ -87,9 +90,14 @@ def _whole(fast: bool) -> AbstractContextManager[None]:
 def compiled() -> bool:
     """Compile the kernels with numba, once, where it is installed; whether they are compiled.
 
-    numba is imported here, at the first solve, not with the module: its import costs a
-    process 0.25 s and 55 MB, and most processes that load Moreau's law never sweep. The module's
-    names are bound to the compiled functions, which find each other there when they compile.
+    numba is imported here, at the first call, not with the module: its import costs a process
+    0.25 s and 55 MB, and most processes that load Moreau's law never sweep. The module's names
+    are bound to the compiled functions, which find each other there when they compile, and each
+    kernel that a solve calls is called once on one spatial contact: numba compiles it then for
+    the types every solve gives it, or loads it from its cache (``cache=True``, about 30 s cold
+    on one core). That is a one-time cost of the process, not of a solve: call this before a
+    solve's budget starts (`lawbench.core.law.Law.prepare`), as the one way into a solve and the
+    study runner do.
     """
     with held():
         return _compile()
@@ -105,7 +113,18 @@ def _compile() -> bool:
     namespace = globals()
     for name in _KERNELS:
         namespace[name] = numba.njit(cache=True)(namespace[name])
+    _warm_up()
     return True
+
+
+def _warm_up() -> None:
+    """Call the kernels that Python calls (a sweep, the blocks, one contact's state) once."""
+    W = scipy.sparse.csr_matrix(np.eye(3))
+    q, mu = np.array([-1.0, 0.5, 0.0]), np.array([0.5])
+    blocks = _blocks(W.indptr, W.indices, W.data, 3)
+    inverse = inverses(blocks)
+    _sweep(W.indptr, W.indices, W.data, blocks, inverse, q, mu, np.zeros(3))
+    _in_a_state(blocks[0], inverse[0], q, 0.5, np.zeros(3))
 
 
 # A block whose condition number exceeds this has no reliable stick solution.
@@ -351,9 +370,10 @@ def one_contact(G: np.ndarray, q: np.ndarray, mu: float) -> np.ndarray | None:
     the law (Coulomb's law with kinematic restitution can have no solution when the normal
     and tangential directions are strongly coupled, as Painlevé's examples).
     """
-    G = np.asarray(G, dtype=float)
+    # As the compiled kernel's types are (`_warm_up`): no compilation in a solve.
+    G, q = np.require(G, float, "CW"), np.require(q, float, "CW")
     with _whole(compiled()):
-        P = _in_a_state(G, inverses(G[None])[0], np.asarray(q, dtype=float), mu, np.zeros(q.size))
+        P = _in_a_state(G, inverses(G[None])[0], q, float(mu), np.zeros(q.size))
     return P if P.size else None
 
 
@@ -458,10 +478,12 @@ def solve_nsgs(
         W = W.copy()
         W.sum_duplicates()
         W.eliminate_zeros()
-    local_q = np.ascontiguousarray(q, dtype=float)
-    mu = np.ascontiguousarray(mu, dtype=float)
+    # C-contiguous and writable (a problem's arrays are read-only), as the types the kernels
+    # are compiled for in `_warm_up`: a read-only array would compile them again in the solve.
+    local_q, mu = np.require(q, float, "CW"), np.require(mu, float, "CW")
+    rows = tuple(np.require(a, None, "CW") for a in (W.indptr, W.indices, W.data))
     with _whole(fast):
-        blocks = _blocks(W.indptr, W.indices, W.data, size)
+        blocks = _blocks(*rows, size)
     inverse = inverses(blocks)
     P = np.zeros(m * size) if start is None else np.array(start, dtype=float)
     spend, sweeps, gate, error, note = current_budget(), 0, tol, np.inf, ""
@@ -470,7 +492,7 @@ def solve_nsgs(
         spend.step("Gauss-Seidel sweeps", note)
         with _whole(fast):
             try:
-                change = _sweep(W.indptr, W.indices, W.data, blocks, inverse, local_q, mu, P)
+                change = _sweep(*rows, blocks, inverse, local_q, mu, P)
             except np.linalg.LinAlgError:  # a block's inverse or an impulse overflowed
                 raise SolverFailure(
                     f"Gauss-Seidel: sweep {sweeps + 1} met a number beyond double precision "

@@ -87,13 +87,13 @@ def cells(
 @functools.lru_cache(maxsize=256)
 def _trial(law: Law, scene: str, example: str) -> Trial | LawbenchError | Exception:
     """The trial of a cell's problem, or the error its solve raised."""
-    from lawbench.core.trial import evaluate
+    from lawbench.core.trial import make_trial
 
     try:
         if scene == "random":
-            return evaluate(law, random_problem(int(example)))
+            return make_trial(law, random_problem(int(example)), judged=False)
         case = CASES.get(scene)
-        return evaluate(law, case, **case.examples[example])
+        return make_trial(law, case, params=case.examples[example], judged=False)
     except Exception as exc:  # the cell records it: refused, budget, or a bug
         return exc
 

@@ -27,11 +27,12 @@ vectors). A generator's bounds are finite, a ``random`` one's ``low <= high`` (b
 ``log = true``), its count at most `MAX_CELLS` and its ``size`` at most `MAX_SIZE`; a grid holds
 at most `MAX_CELLS` rows. Rows are the Cartesian product in the order written: cases, then laws,
 then parameters, then options, then transforms. A malformed generator raises `InvalidProblem` as
-the grid is read; every row is checked before any work: an unknown name or a value out of range
-raises `InvalidProblem`. A row is a `lawbench.studies.study.Job`; `RunSpec.plan` gives the
-executor's plan (`lawbench.studies.runner.run`). `RunSpec.count` counts the rows from the grid's
-sizes and `RunSpec.sample` builds a few of them alone, so a grid of millions of rows is sized and
-timed before it is built.
+the grid is read; every row is checked before any work: an unknown name, a value out of range,
+options of a law that has no cell in their grid or a check named twice raise `InvalidProblem`.
+A row is a `lawbench.studies.study.Job`; `RunSpec.plan` gives the executor's plan
+(`lawbench.studies.runner.run`). `RunSpec.count` counts the rows from the grid's sizes and
+`RunSpec.sample` builds a few of them alone, so a grid of millions of rows is sized and timed before
+it is built.
 """
 
 from __future__ import annotations
@@ -102,9 +103,11 @@ class RunSpec:
         for number, grid in enumerate(grids):
             _check_grid(grid, number)
         checks = _strings(data.get("checks", list(SINGLE_SOLVE)), "checks")
-        for name in checks:
+        for number, name in enumerate(checks):
             if name not in CHECKS:
                 raise InvalidProblem(f"spec: unknown check {name!r}; known: {', '.join(CHECKS)}")
+            if name in checks[:number]:
+                raise InvalidProblem(f"spec: key 'checks' names the check {name!r} twice")
         sizes = _typed(data.get("continuity_sizes", [1e-2, 1e-4, 1e-6]), list, "continuity_sizes")
         # Relative perturbations of the gaps and velocities: positive and finite, or no probe.
         if not all(
@@ -248,9 +251,7 @@ def _check_grid(grid: Any, number: int) -> None:
 
 
 def _names(grid: Mapping[str, Any], key: str, registry: Any) -> list[str]:
-    names = grid.get(key, ["*"])
-    if isinstance(names, str):
-        names = [names]
+    names = _strings(grid.get(key, ["*"]), key)
     if names == ["*"]:
         return registry.names()
     for name in names:
@@ -316,31 +317,31 @@ def _blocks(grid: Mapping[str, Any], seed: int, number: int) -> Iterator[_Block]
         }
     )
     option_grids = dict(grid.get("options", {}))
+    pairs = [
+        (case_name, law_name)
+        for case_name in cases
+        for law_name in laws
+        if not every_law or LAWS.get(law_name).tags.covers(CASES.get(case_name).requires)
+    ]
     for law in option_grids:
-        LAWS.get(law)
+        if LAWS.get(law) and law not in {law_name for _, law_name in pairs}:
+            raise InvalidProblem(f"spec grid[{number}].options.{law}: {law!r} has no cell here")
     transforms = _strings(grid.get("transforms", [""]), f"grid[{number}].transforms")
     for spelling in filter(None, transforms):
         parse(spelling)
-    for case_name in cases:
-        case = CASES.get(case_name)
-        for law_name in laws:
-            law = LAWS.get(law_name)
-            if every_law and not law.tags.covers(case.requires):
-                continue
-            option_points = Product(
-                {
-                    name: grid_points(spec, seed, (number, "option", law_name, name))
-                    for name, spec in dict(option_grids.get(law_name, {})).items()
-                }
-            )
-            parameter_sets = (
-                [dict(p) for p in case.examples.values()]
-                if grid.get("examples", False)
-                else param_points
-            )
-            yield _Block(
-                number, law, case, law_name, case_name, parameter_sets, option_points, transforms
-            )
+    for case_name, law_name in pairs:
+        case, law = CASES.get(case_name), LAWS.get(law_name)
+        option_points = Product(
+            {
+                name: grid_points(spec, seed, (number, "option", law_name, name))
+                for name, spec in dict(option_grids.get(law_name, {})).items()
+            }
+        )
+        examples = [dict(p) for p in case.examples.values()]
+        parameter_sets = examples if grid.get("examples", False) else param_points
+        yield _Block(
+            number, law, case, law_name, case_name, parameter_sets, option_points, transforms
+        )
 
 
 def _size(points: Sequence[Any]) -> int:

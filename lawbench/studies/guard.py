@@ -18,6 +18,7 @@ Two forms, one rule: a job that has not answered after its budget is stopped and
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import threading
@@ -104,7 +105,10 @@ def _serve(connection: Connection) -> None:
             return
         if message is None:
             return
-        number, function, args = message
+        number, function, args, before = message
+        if before is not None:
+            with contextlib.suppress(Exception):  # the task meets the failure and records it
+                before()
         connection.send((_BEGUN, number))
         start = time.perf_counter()
         with warnings.catch_warnings(record=True) as caught:
@@ -137,6 +141,7 @@ class _Task:
     function: Callable[..., Any]
     args: tuple[Any, ...]
     budget: float
+    before: Callable[[], Any] | None = None
 
 
 class Guard:
@@ -162,10 +167,20 @@ class Guard:
         self._results: dict[int, Result] = {}
         self._count = 0
 
-    def submit(self, function: Callable[..., Any], *args: Any, budget: float | None = None) -> int:
-        """Queue ``function(*args)``; return the handle of its result."""
+    def submit(
+        self,
+        function: Callable[..., Any],
+        *args: Any,
+        budget: float | None = None,
+        before: Callable[[], Any] | None = None,
+    ) -> int:
+        """Queue ``function(*args)``; return the handle of its result.
+
+        ``before()`` runs in the worker first, outside the task's budget, like the worker's
+        imports: the one-time work of a process that the task needs (compiling a law's kernels).
+        """
         self._count += 1
-        self._queue.append(_Task(self._count, function, args, budget or self.budget_s))
+        self._queue.append(_Task(self._count, function, args, budget or self.budget_s, before))
         return self._count
 
     def result(self, handle: int) -> Result:
@@ -235,7 +250,7 @@ class Guard:
                 task = self._queue.popleft()
                 worker.task, worker.budget = task.number, task.budget
                 worker.deadline = time.monotonic() + STARTUP_S + task.budget
-                worker.connection.send((task.number, task.function, task.args))
+                worker.connection.send((task.number, task.function, task.args, task.before))
         busy = [w for w in self._pool if w.task is not None]
         if not busy:
             raise RuntimeError("the guard waits for a result that was never submitted")

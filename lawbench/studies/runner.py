@@ -5,7 +5,10 @@ its `lawbench.studies.record.Record` row; it never raises: a failure is recorded
 class and message and the run goes on (nevergrad's runner does the same). An `Executor` runs cells
 in this process (``serial``), in local worker processes (``processes``) or on a Dask cluster
 (``dask``), every cell under the same per-job wall-clock guard (`lawbench.studies.guard`): a cell
-stopped there is a *budget* cell naming the ``wall-clock guard`` and its seconds.
+stopped there is a *budget* cell naming the ``wall-clock guard`` and its seconds. Before any cell
+starts, each of their laws does here, once, its one-time work of a process (`Law.prepare`:
+compiling its kernels into numba's cache), and a worker does it again (a load from that cache)
+before a cell's budget starts: no cell's budget pays for it.
 
 `run` holds a lock on its output and writes a plan's records in checksummed chunks into
 ``OUT.parts/`` as they finish (`lawbench.studies.runfile.Store`), so a run that is interrupted
@@ -17,6 +20,7 @@ the same whichever executor ran it, up to the timing columns (``wall_time_s``, `
 
 from __future__ import annotations
 
+import functools
 import multiprocessing
 import os
 import sys
@@ -32,8 +36,9 @@ import pandas as pd
 from tqdm import tqdm
 
 from lawbench.checks import run_checks
-from lawbench.core.errors import InvalidProblem
+from lawbench.core.errors import InvalidProblem, LawbenchError
 from lawbench.core.guards import alarm, stopped
+from lawbench.core.law import LAWS
 from lawbench.files.paths import output_file
 from lawbench.studies.guard import (
     BUDGET_S,
@@ -112,8 +117,21 @@ KILL_GRACE_S = 2.0
 
 
 def _guarded(guard: Guard, task: Task, budget_s: float) -> int:
-    """Submit ``task`` to ``guard``: its alarm rings at ``budget_s``, the kill comes after."""
-    return guard.submit(compute, task, budget_s, budget=budget_s + KILL_GRACE_S)
+    """Submit ``task`` to ``guard``: its alarm rings at ``budget_s``, the kill comes after.
+
+    Its worker prepares the cell's law first, outside the budget (`prepare`).
+    """
+    before = functools.partial(prepare, task.job.law)
+    return guard.submit(compute, task, budget_s, budget=budget_s + KILL_GRACE_S, before=before)
+
+
+def prepare(law: str) -> None:
+    """The one-time work of this process that the law named ``law`` needs (`Law.prepare`)."""
+    try:
+        found = LAWS.get(law)
+    except LawbenchError:  # a law that cannot load: each of its cells records why
+        return
+    found.prepare()
 
 
 # The guard of a Dask worker process, started with its first chunk.
@@ -194,7 +212,12 @@ class Executor:
             self._cluster.close()
 
     def run(self, tasks: Sequence[Task]) -> Iterator[tuple[int, dict[str, Any]]]:
-        """``(position in tasks, row)`` of every task, in the order they finish."""
+        """``(position in tasks, row)`` of every task, in the order they finish.
+
+        The tasks' laws are prepared here first (`Law.prepare`), before any cell's budget.
+        """
+        for name in sorted({task.job.law for task in tasks}):
+            prepare(name)
         if self.kind == "serial":
             for position, task in enumerate(tasks):
                 yield position, compute(task, self.budget_s)

@@ -135,6 +135,8 @@ class Job:
         problem given as it is (no scene, so no scene references, and the momenta every
         contact leaves alone are the conserved ones).
 
+        An answer that breaks a promise is returned as it is: the cell's checks class it.
+
         Raises
         ------
         InvalidProblem, NotApplicable, SolverFailure
@@ -149,6 +151,7 @@ class Job:
             options=self.options,
             transform=self.transform,
             settings=settings,
+            judged=False,
         )
 
     def command(self, max_seconds: float | None = None) -> str:

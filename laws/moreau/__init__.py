@@ -154,6 +154,7 @@ from lawbench.laws.moreau.methods import (
 )
 from lawbench.numerics import cones
 from lawbench.numerics.gauss_seidel import (
+    compiled,
     error_of,
     in_local_order,
     local_order,
@@ -189,6 +190,11 @@ class Moreau(Law):
     takes_sparse = True
     # Its frictionless impulses solve the LCP that clarabel and Siconos' Lemke are timed on.
     bench_roles = ("lcp",)
+
+    def prepare(self, problem: object = None) -> None:
+        """Compile the Gauss-Seidel kernels (`compiled`) where a solve may sweep: with friction."""
+        if problem is None or getattr(problem, "frictional", True):
+            compiled()
 
     def rule_for_separating(self, options: dict[str, Any]) -> str:
         """The rule of option ``separating``."""
