@@ -38,6 +38,7 @@ import scipy.optimize
 
 from lawbench.core.errors import SolverFailure
 from lawbench.core.geometry import TOLERANCE, Body, ContactPair, Geometry
+from lawbench.core.guards import held
 from lawbench.core.law import Law, current_budget
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
@@ -151,8 +152,19 @@ def require(module: str) -> None:
         )
 
 
+def whole(module: str) -> ModuleType:
+    """Import ``module`` in one piece: a time bound that rings meanwhile rings as it ends.
+
+    An engine's compiled bindings stopped half-way through their import fail every later import
+    in the process ("already registered"), so a first solve's bound must not cut it
+    (`lawbench.core.guards.held`).
+    """
+    with held():
+        return importlib.import_module(module)
+
+
 def quietly(module: str) -> ModuleType:
-    """Import ``module`` with the process's stderr (file descriptor 2) closed to its writes.
+    """Import ``module`` `whole`, with the process's stderr (descriptor 2) closed to its writes.
 
     pybullet writes its build time there from C when imported, which would mix with lawbench's
     own messages on stderr.
@@ -161,11 +173,11 @@ def quietly(module: str) -> ModuleType:
     try:
         saved = os.dup(2)
     except OSError:  # no stderr to keep clean
-        return importlib.import_module(module)
+        return whole(module)
     null = os.open(os.devnull, os.O_WRONLY)
     try:
         os.dup2(null, 2)
-        return importlib.import_module(module)
+        return whole(module)
     finally:
         os.dup2(saved, 2)
         os.close(saved)

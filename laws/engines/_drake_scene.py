@@ -7,7 +7,6 @@ and steps them, by the conventions the law's docstring states. pydrake is import
 from __future__ import annotations
 
 import functools
-import importlib
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -17,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from lawbench.core.geometry import Body, Joint, rotation_matrix
-from lawbench.laws.engines._base import Force, Scene, Start, corner, plane_axes
+from lawbench.laws.engines._base import Force, Scene, Start, corner, plane_axes, whole
 
 # Drake's warning at every half space it is given, about deformable bodies this law never makes.
 _HALF_SPACE_WARNING = "half spaces are not currently supported for deformable contact"
@@ -60,9 +59,7 @@ def _drake() -> SimpleNamespace:
     Drake's warning at each half space is filtered out of its logger: it is about deformable
     bodies.
     """
-    modules = {
-        name.replace(".", "_"): importlib.import_module(f"pydrake.{name}") for name in _MODULES
-    }
+    modules = {name.replace(".", "_"): whole(f"pydrake.{name}") for name in _MODULES}
     logging.getLogger("drake").addFilter(
         lambda record: _HALF_SPACE_WARNING not in record.getMessage()
     )
