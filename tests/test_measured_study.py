@@ -211,34 +211,32 @@ def test_a_study_needs_a_worker():
         measured_study("kharaz", ["whittaker"], workers=0)
 
 
-def test_an_engine_is_fitted_through_the_set_s_geometry():
-    """The cube tosses carry their geometry, so an engine is fitted and judged like a law, the
-    pairs taking each trial's coefficients (an engine refuses a problem whose coefficients are
-    not its geometry's). A set made by PyBullet at its tuned settings, e = 0.4 and mu = 0.3, on
-    one-corner impacts is fitted back to them."""
-    pytest.importorskip("pybullet")
-    law = LAWS.get("pybullet")
-    one = [i for i in MEASUREMENTS.get("cube").impacts if i.problem.m == 1][:12]
-    velocities, failures = predict(law, one, {"e": 0.4, "mu": 0.3}, study_options(law))
-    assert not failures
-    made = [dataclasses.replace(i, v_after=v) for i, v in zip(one, velocities, strict=True)]
-    study = measured_study(small_set(made[:6], made[6:]), ["pybullet"])
-    row = study.table.set_index("law").loc["pybullet"]
-    assert row["e"] == pytest.approx(0.4, abs=1e-3) and row["mu"] == pytest.approx(0.3, abs=1e-3)
-    assert row["median_error"] < 1e-3 and row["refused"] == 0
+def _cube_one_corner_tosses() -> list:
+    return [i for i in MEASUREMENTS.get("cube").impacts if i.problem.m == 1][:12]
 
 
-def test_an_engine_is_fitted_back_on_ellipse_bounces():
-    """The ellipse bounces carry their geometry too: a set made by MuJoCo at its tuned
-    settings, e = 0.6 and mu = 0.1 (the ellipse slips through most bounces), on ten bounces is
-    fitted back to them."""
-    pytest.importorskip("mujoco")
-    law = LAWS.get("mujoco")
-    ten = evenly(ELLIPSE.impacts, 10)
-    velocities, failures = predict(law, ten, {"e": 0.6, "mu": 0.1}, study_options(law))
+@pytest.mark.parametrize(
+    ("engine", "impacts", "coefficients"),
+    [
+        ("pybullet", _cube_one_corner_tosses, {"e": 0.4, "mu": 0.3}),
+        ("mujoco", lambda: evenly(ELLIPSE.impacts, 12), {"e": 0.6, "mu": 0.1}),
+    ],
+)
+def test_an_engine_is_fitted_through_the_set_s_geometry(engine, impacts, coefficients):
+    """The cube tosses and the ellipse bounces carry their geometry, so an engine is fitted and
+    judged like a law, the pairs taking each trial's coefficients (an engine refuses a problem
+    whose coefficients are not its geometry's). A set an engine makes at its tuned settings is
+    fitted back to the coefficients it was made with: PyBullet's one-corner cube impacts at
+    e = 0.4 and mu = 0.3, and MuJoCo's ellipse bounces at e = 0.6 and mu = 0.1 (the ellipse slips
+    through most of them)."""
+    pytest.importorskip(engine)
+    law = LAWS.get(engine)
+    chosen = impacts()
+    velocities, failures = predict(law, chosen, coefficients, study_options(law))
     assert not failures
-    made = [dataclasses.replace(i, v_after=v) for i, v in zip(ten, velocities, strict=True)]
-    study = measured_study(small_set(made[:5], made[5:]), ["mujoco"])
-    row = study.table.set_index("law").loc["mujoco"]
-    assert row["e"] == pytest.approx(0.6, abs=1e-3) and row["mu"] == pytest.approx(0.1, abs=1e-3)
+    made = [dataclasses.replace(i, v_after=v) for i, v in zip(chosen, velocities, strict=True)]
+    study = measured_study(small_set(made[:6], made[6:]), [engine])
+    row = study.table.set_index("law").loc[engine]
+    for name, value in coefficients.items():
+        assert row[name] == pytest.approx(value, abs=1e-3)
     assert row["median_error"] < 1e-3 and row["refused"] == 0
