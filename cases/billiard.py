@@ -42,6 +42,7 @@ shot is the frictionless binary impact of the cue on the ball:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -215,15 +216,17 @@ class Billiard(Case):
             )
             for j in range(2)
         ]
-        return ImpactProblem(
+        problem = ImpactProblem(
             M=np.diag([params["cue_mass"], m, m, m, inertia, inertia, inertia]),
             Wn=Wn,
             Wt=Wt,
             v=np.array([params["speed"], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
             contacts=contacts,
             bodies={"cue": (0,), "ball": tuple(range(1, 7))},
-            geometry=shot_geometry(params),
         )
+        # The geometry once the problem's numbers are checked: a radius whose formulas leave
+        # double precision is refused by the problem's field, not by a shape built from it.
+        return dataclasses.replace(problem, geometry=shot_geometry(params))
 
     def coordinates(self, params: Params) -> list[str]:
         """The cue's speed, the ball's velocity and angular velocity."""
