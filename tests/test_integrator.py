@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.core.errors import BudgetExceeded
+from lawbench.core.errors import BudgetExceeded, SolverFailure
 from lawbench.core.law import Budget
 from lawbench.numerics.integrator import EventIntegrator
 
@@ -183,3 +183,24 @@ def turning_slip_problem() -> lawbench.ImpactProblem:
         v=-v if Wn[:, 0] @ v > 0 else v,
         contacts=[lawbench.Contact(e=0.5, mu=0.8)],
     )
+
+
+def test_event_functions_that_leave_floating_point_are_a_solver_failure():
+    """An event function that overflows has no sign: the solve fails and says where."""
+
+    def overflowing(t: float, y: np.ndarray) -> np.ndarray:
+        force = np.exp(800.0 * y[0])  # inf once sin t passes about 0.89
+        return np.array([force - force])
+
+    with Budget("a law"), np.errstate(over="ignore", invalid="ignore"):
+        with pytest.raises(SolverFailure, match="a law: DOP853: event functions not finite"):
+            EventIntegrator(rtol=1e-12, atol=1e-14).to_event(
+                harmonic, 0.0, np.array([0.0, 1.0]), overflowing, x_end=3.0
+            )
+
+
+@pytest.mark.slow
+def test_a_compliant_contact_whose_force_overflows_fails_with_the_reason():
+    """Hertz's force at exponent 1e6 overflows in the billiard's contacts: exit 4, not 1."""
+    with pytest.raises(SolverFailure, match="event functions not finite"):
+        lawbench.solve("compliant", "billiard", exponent=1e6)

@@ -141,6 +141,7 @@ class EventIntegrator:
             start = solver.t_old
             xs = np.linspace(solver.t_old, solver.t, self.samples + 1)[1:]
             for x, after in zip(xs, self._values(events, dense, xs, solver.y), strict=True):
+                self._finite(after, x)
                 crossed = np.flatnonzero(_fires(before, after, direction))
                 if crossed.size:
                     spend.event()
@@ -165,6 +166,20 @@ class EventIntegrator:
         for x in xs:
             yield np.asarray(events(x, y_end if x == xs[-1] else dense(x)), dtype=float)
 
+    def _finite(self, values: np.ndarray, x: float) -> np.ndarray:
+        """``values``, the event functions at ``x``, or `SolverFailure` if one left floating point.
+
+        An event function that overflows (a contact force of a huge exponent) has no sign to
+        follow: the step cannot say where the event is.
+        """
+        values = np.asarray(values, dtype=float)
+        if not np.all(np.isfinite(values)):
+            raise SolverFailure(
+                f"{current_budget().law}: {self.method_name}: event functions not finite at "
+                f"{x:.6g} ({values.tolist()}): the state left floating point"
+            )
+        return values
+
     def _locate(
         self,
         events: Callable[[float, np.ndarray], np.ndarray],
@@ -174,7 +189,7 @@ class EventIntegrator:
         hi: float,
     ) -> Event:
         def value(i: int, x: float) -> float:
-            return float(events(x, dense(x))[i])
+            return float(self._finite(events(x, dense(x)), x)[i])
 
         where = np.array([crossing(partial(value, int(i)), lo, hi, self.past) for i in crossed])
         order = np.argsort(where, kind="stable")
