@@ -7,6 +7,10 @@ cone (height ``cone_height``) whose apex touches the table; one spatial contact 
 normal z, tangents x and y. Its axis lies in the x-z plane at ``tilt`` above the table, the
 upper end towards +x: ``a = (cos tilt, 0, sin tilt)`` from the apex.
 
+The scene declares no geometry, so the engines refuse it: at the defaults the cone's base rim
+lies h2 sin(tilt) - r cos(tilt) = -67 mm below the table, so no solid of these proportions
+touches the table at its apex alone.
+
 Parameters (defaults are the talk's values where it gives them): ``mass`` 1 kg, ``radius`` 1 m,
 ``cylinder_length`` (h1) 3 m, ``cone_height`` (h2) 0.5 m, ``e`` 0.5 (energetic), ``mu`` 0.8,
 ``tangential_stiffness_ratio`` (eta0^2) 1.2, ``velocity`` 5 (cos 30°, 0, -sin 30°) m/s and

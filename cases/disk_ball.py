@@ -6,6 +6,9 @@ horizontally at speed vb strikes the disk's face normally at point D, at height 
 disk's centre O on its vertical axis. Source: H. J. Zhang, C. S. Liu, Z. Zhao, B. Brogliato,
 *Energy evolution in complex impacts with friction*, Sci. China Phys. Mech. Astron. 56 (2013)
 875-881, Section 2 and eq. (1); the disk-floor line contact discretized into three points.
+The scene declares no geometry, so the engines refuse it: an upright disk on a floor is a line
+contact, which an engine meets at points of its own rather than the source's three, and the
+ball is a particle.
 
 Generalized coordinates (the source's): q = (yb, zb, yd, zd, theta); velocities ``vyb, vzb``
 (ball, m/s), ``vyd, vzd`` (disk centre, m/s), ``omega`` (disk, rad/s). y is horizontal along

@@ -9,6 +9,8 @@ floor (normal ``(0, 1)``, tangent ``(1, 0)``): its gap rate is
 ``l1 omega1 sin theta1 + l2 omega2 sin theta2`` and its slip
 ``l1 omega1 cos theta1 + l2 omega2 cos theta2``. Gravity and the pins' friction play no part
 in the impact.
+The scene declares no geometry, so the engines refuse it: link 2 turns on a pin carried by
+link 1, and a geometry's joints hold a body to the world (free, planar, hinge, slide, fixed).
 
 Parameters (defaults): ``lengths`` (1, 1) m, ``masses`` (1, 1) kg, ``angles`` (60, 45)
 degrees, ``omegas`` (0, -4) rad/s, ``e`` 0.9, ``mu`` 0.5.
