@@ -11,6 +11,7 @@ ignore e (the elastic chain keeps a third of its energy).
 
 import importlib
 import sys
+import threading
 
 import numpy as np
 import pytest
@@ -123,6 +124,31 @@ def test_pybullet_meets_gaps_event_by_event():
         "pybullet", "three_ball_chain", gaps=[0.0, 1e-3], options={"settings": "tuned"}
     )
     np.testing.assert_allclose(outcome.v_plus, [0.0, 0.0, 1.0], atol=1e-9)
+
+
+def test_pybullet_defaults_let_a_closed_contact_approach_by_the_slop_over_the_step(monkeypatch):
+    """The finding's witness: the falling rod grazing the floor at 1e-2 m/s (e = 0) leaves at
+    un+ = -slop / dt at 1/240 s, a law property of the defaults; with contactSlop 0, 1000
+    solver iterations and no residual threshold it no longer approaches."""
+    from lawbench.core.trial import make_trial
+
+    def rod():
+        return make_trial("pybullet", "falling_rod", params={"e": 0.0}, transform="grazing=0.01")
+
+    trial = rod()
+    after = trial.problem.Wn.T @ trial.outcome.v_plus
+    assert after[0] == pytest.approx(-pybullet_law.SLOP * 240.0, rel=1e-2)
+    result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
+    assert str(result.verdict) == "law property"
+    assert "contactSlop" in result.claim.source
+    monkeypatch.setattr(pybullet_law, "_CLIENTS", threading.local())
+    client = pybullet_law._client("default").id
+    rigid = {"contactSlop": 0.0, "numSolverIterations": 1000, "solverResidualThreshold": 0.0}
+    pybullet.setPhysicsEngineParameter(physicsClientId=client, **rigid)
+    try:
+        assert lawbench.run_checks(rod(), checks=["admissible"])["admissible"].passed
+    finally:
+        pybullet.disconnect(client)
 
 
 def test_pybullet_refuses_coefficients_no_per_body_values_multiply_to():
@@ -297,6 +323,23 @@ def test_drake_defaults_let_a_flat_box_gain_energy_where_its_contact_point_jumps
     tuned = lawbench.solve("drake", block, {"settings": "tuned"})
     moreau = lawbench.solve("moreau", block)
     assert relative(tuned.v_plus, moreau.v_plus, block.v) < 1e-2
+
+
+def test_drake_defaults_leave_a_spinning_body_s_contact_approaching_along_its_frozen_normal():
+    """The finding's witness: the falling rod grazing the floor at 1e-2 m/s (e = 0), spinning
+    at 3.4 rad/s, turns in Drake's soft impact, and its end's gap rate at the frozen
+    configuration is left approaching by less than |omega|^2 r T, a law property of the
+    defaults; the same approach without the spin leaves separating."""
+    from lawbench.core.trial import make_trial
+
+    trial = make_trial("drake", "falling_rod", params={"e": 0.0}, transform="grazing=0.01")
+    assert (trial.problem.Wn.T @ trial.outcome.v_plus)[0] < -1e-3
+    result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
+    assert str(result.verdict) == "law property"
+    assert result.claim.region.text.endswith(_base.turning_impact.text)
+    still = lawbench.evaluate("drake", "falling_rod", e=0.0, velocities=[2.2, -0.01, 0.0])
+    assert (still.problem.Wn.T @ still.outcome.v_plus)[0] > 1e-3
+    assert not _base.turning_impact(still)
 
 
 def test_drake_defaults_leave_a_contact_at_one_over_its_dissipation_times_speed():

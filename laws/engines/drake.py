@@ -104,6 +104,7 @@ from lawbench.laws.engines._base import (
     moving_impact,
     overlap_given_back,
     require,
+    turning_impact,
 )
 from lawbench.laws.engines._drake_scene import DrakeScene, Tuning
 
@@ -333,6 +334,18 @@ class Drake(EngineLaw):
             "billiard shot lasts 16 ms, the ball slides out from under the tip: un+ = -0.24 "
             "m/s)",
             (("billiard", "default"),),
+        ),
+        Claim(
+            "admissible",
+            option("settings", "default") & turning_impact,
+            f"{_DOCS}: DefaultProximityProperties (point_stiffness 1e6 N/m), MultibodyPlantConfig "
+            "(time_step 1 ms)",
+            "at its defaults a contact is soft, and a body spinning through the impact turns "
+            "while it lasts: the engine lets go where the contact separates at the configuration "
+            "reached, and the gap rate read at the frozen configuration is off by up to "
+            "|omega|^2 r T (the falling rod grazing the floor at 1e-2 m/s with e = 0, spinning at "
+            "3.4 rad/s: un+ = -3.2e-3 m/s after 7 ms, -6.2e-4 after 2.4 ms at dt = 1e-5 s; "
+            "without the spin it leaves separating, +1.7e-3)",
         ),
         *_YARDSTICK,
     )
