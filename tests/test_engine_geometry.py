@@ -16,7 +16,7 @@ mujoco = pytest.importorskip("mujoco")
 pydrake = pytest.importorskip("pydrake")
 
 # Imported once the engines are known to be installed.
-from lawbench.laws.engines import _base  # noqa: E402
+from lawbench.laws.engines import _base, _bullet_coefficients  # noqa: E402
 from lawbench.laws.engines import drake as drake_law  # noqa: E402
 from lawbench.laws.engines import mujoco as mujoco_law  # noqa: E402
 from lawbench.laws.engines import pybullet as pybullet_law  # noqa: E402
@@ -104,7 +104,7 @@ def engine_columns_pybullet(problem, step=1e-7):
     """
     geometry = problem.geometry
     start = _base._displacement(problem, geometry)
-    coefficients = pybullet_law._coefficients(geometry, True)
+    coefficients = _bullet_coefficients.body_coefficients(geometry, True)
     velocities = np.zeros((len(geometry.bodies), 6))
     scene = pybullet_law._BulletScene(
         _base.Start(problem, geometry.poses(start), velocities, "tuned", 1e-4, 1.0), coefficients

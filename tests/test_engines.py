@@ -11,6 +11,7 @@ ignore e (the elastic chain keeps a third of its energy).
 
 import importlib
 import sys
+import threading
 
 import numpy as np
 import pytest
@@ -27,7 +28,7 @@ mujoco = pytest.importorskip("mujoco")
 pydrake = pytest.importorskip("pydrake")
 
 # Imported once the engines are known to be installed.
-from lawbench.laws.engines import _base  # noqa: E402
+from lawbench.laws.engines import _base, _bullet_coefficients  # noqa: E402
 from lawbench.laws.engines import drake as drake_law  # noqa: E402
 from lawbench.laws.engines import mujoco as mujoco_law  # noqa: E402
 from lawbench.laws.engines import pybullet as pybullet_law  # noqa: E402
@@ -117,6 +118,22 @@ def test_pybullet_tuned_gains_energy_where_the_slip_reverses_as_moreau_s_law_doe
     assert "Kane and Levinson" in result.claim.source
 
 
+def test_pybullet_defaults_gain_energy_where_the_slip_reverses_with_the_squared_coefficients():
+    """The finding's witness at the defaults: the rod at 43 degrees (e = 0.9, mu = 0.75) acts
+    with e^2 and mu^2 and leaves with 0.24 % more energy, near Moreau's answer at those
+    coefficients (+0.43 %), a law property, not unexplained."""
+    params = {"angle": 43.0, "e": 0.9, "mu": 0.75, "velocities": [-0.5, -1.0, 0.0]}
+    trial = lawbench.evaluate("pybullet", "falling_rod", **params)
+    gain = trial.outcome.T_plus / trial.problem.T_minus - 1.0
+    assert gain == pytest.approx(2.35e-3, rel=1e-2)
+    squared = {**params, "e": 0.9**2, "mu": 0.75**2}
+    moreau = lawbench.solve("moreau", "falling_rod", **squared)
+    assert relative(trial.outcome.v_plus, moreau.v_plus, trial.problem.v) < 5e-3
+    result = lawbench.run_checks(trial, checks=["energy_gain"])["energy_gain"]
+    assert str(result.verdict) == "law property"
+    assert "Kane and Levinson" in result.claim.source
+
+
 def test_pybullet_meets_gaps_event_by_event():
     """Contact 1 open by a millimetre: Newton's cradle, as rigid binary impacts give."""
     outcome = lawbench.solve(
@@ -125,13 +142,38 @@ def test_pybullet_meets_gaps_event_by_event():
     np.testing.assert_allclose(outcome.v_plus, [0.0, 0.0, 1.0], atol=1e-9)
 
 
+def test_pybullet_defaults_let_a_closed_contact_approach_by_the_slop_over_the_step(monkeypatch):
+    """The finding's witness: the falling rod grazing the floor at 1e-2 m/s (e = 0) leaves at
+    un+ = -slop / dt at 1/240 s, a law property of the defaults; with contactSlop 0, 1000
+    solver iterations and no residual threshold it no longer approaches."""
+    from lawbench.core.trial import make_trial
+
+    def rod():
+        return make_trial("pybullet", "falling_rod", params={"e": 0.0}, transform="grazing=0.01")
+
+    trial = rod()
+    after = trial.problem.Wn.T @ trial.outcome.v_plus
+    assert after[0] == pytest.approx(-pybullet_law.SLOP * 240.0, rel=1e-2)
+    result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
+    assert str(result.verdict) == "law property"
+    assert "contactSlop" in result.claim.source
+    monkeypatch.setattr(pybullet_law, "_CLIENTS", threading.local())
+    client = pybullet_law._client("default").id
+    rigid = {"contactSlop": 0.0, "numSolverIterations": 1000, "solverResidualThreshold": 0.0}
+    pybullet.setPhysicsEngineParameter(physicsClientId=client, **rigid)
+    try:
+        assert lawbench.run_checks(rod(), checks=["admissible"])["admissible"].passed
+    finally:
+        pybullet.disconnect(client)
+
+
 def test_pybullet_refuses_coefficients_no_per_body_values_multiply_to():
     geometry = lawbench.CASES.get("ball_chain").build(n=3, e=[0.0, 1.0]).geometry
-    assert pybullet_law._factors(geometry, [0.0, 1.0]) == [0.0, 1.0, 1.0]
-    assert pybullet_law._factors(geometry, [0.5, 0.5]) == [1.0, 0.5, 1.0]
-    assert pybullet_law._factors(geometry, [1.0, 0.0]) == [1.0, 1.0, 0.0]
+    assert _bullet_coefficients.factors(geometry, [0.0, 1.0]) == [0.0, 1.0, 1.0]
+    assert _bullet_coefficients.factors(geometry, [0.5, 0.5]) == [1.0, 0.5, 1.0]
+    assert _bullet_coefficients.factors(geometry, [1.0, 0.0]) == [1.0, 1.0, 0.0]
     three = lawbench.CASES.get("ball_chain").build(n=4, e=[0.5, 0.0, 0.5]).geometry
-    assert pybullet_law._factors(three, [0.5, 0.0, 0.5]) is None
+    assert _bullet_coefficients.factors(three, [0.5, 0.0, 0.5]) is None
 
 
 # 2. MuJoCo: tuned approaches Moreau's law; its defaults ignore e.
@@ -297,6 +339,41 @@ def test_drake_defaults_let_a_flat_box_gain_energy_where_its_contact_point_jumps
     tuned = lawbench.solve("drake", block, {"settings": "tuned"})
     moreau = lawbench.solve("moreau", block)
     assert relative(tuned.v_plus, moreau.v_plus, block.v) < 1e-2
+
+
+def test_drake_defaults_leave_a_spinning_body_s_contact_approaching_along_its_frozen_normal():
+    """The finding's witness: the falling rod grazing the floor at 1e-2 m/s (e = 0), spinning
+    at 3.4 rad/s, turns in Drake's soft impact, and its end's gap rate at the frozen
+    configuration is left approaching by less than |omega|^2 r T, a law property of the
+    defaults; the same approach without the spin leaves separating."""
+    from lawbench.core.trial import make_trial
+
+    trial = make_trial("drake", "falling_rod", params={"e": 0.0}, transform="grazing=0.01")
+    assert (trial.problem.Wn.T @ trial.outcome.v_plus)[0] < -1e-3
+    result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
+    assert str(result.verdict) == "law property"
+    assert result.claim.region.text.endswith(_base.turning_impact.text)
+    still = lawbench.evaluate("drake", "falling_rod", e=0.0, velocities=[2.2, -0.01, 0.0])
+    assert (still.problem.Wn.T @ still.outcome.v_plus)[0] > 1e-3
+    assert not _base.turning_impact(still)
+
+
+def test_drake_defaults_report_forces_that_miss_part_of_the_momentum_at_small_steps():
+    """The finding's witness: the lamina at dt = 1e-4 s. Drake's own velocity after the impact
+    separates the contact (+0.020 m/s), the impulses of the contact results it reports leave
+    it approaching (-0.012 m/s), a law property of the defaults; at the default 1 ms they agree
+    to 1e-4."""
+    from lawbench.core.trial import make_trial
+
+    trial = make_trial("drake", "lamina", options={"dt": 1e-4}, judged=False)
+    engine = np.asarray(trial.outcome.diagnostics["engine_v_plus"])
+    assert (trial.problem.Wn.T @ engine)[0] == pytest.approx(0.020, abs=1e-3)
+    assert (trial.problem.Wn.T @ trial.outcome.v_plus)[0] == pytest.approx(-0.012, abs=1e-3)
+    result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
+    assert str(result.verdict) == "law property"
+    assert result.claim.region.text.endswith(_base.misreported_impulse.text)
+    coarse = make_trial("drake", "lamina", judged=False).outcome
+    assert coarse.diagnostics["engine_velocity_gap"] < 1e-4
 
 
 def test_drake_defaults_leave_a_contact_at_one_over_its_dissipation_times_speed():

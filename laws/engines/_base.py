@@ -40,7 +40,7 @@ from lawbench.core.errors import SolverFailure
 from lawbench.core.geometry import TOLERANCE, Body, ContactPair, Geometry
 from lawbench.core.guards import held
 from lawbench.core.law import Law, current_budget
-from lawbench.core.outcome import Outcome
+from lawbench.core.outcome import Outcome, gap_rates
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec
 from lawbench.core.tags import Tags
@@ -93,6 +93,100 @@ def _moved(trial: Any) -> bool:
 moving_impact = Region(
     f"a body moves by more than {MOVED:g} of its size during the engine's impact", _moved
 )
+
+
+def _turned(trial: Any) -> bool:
+    """Whether the bodies' turning in the engine's impact accounts for every approach after it.
+
+    A contact's gap rate after the impact is read along its lever arm r at the configuration the
+    problem is frozen at, while the engine ends the impact at the configuration its bodies have
+    reached: a body that turns by ``theta = |omega| T`` in the impact's time T has carried its
+    contact point's arm through theta, which moves the point's velocity ``omega x r`` by up to
+    ``|omega| r theta``. The region holds where some closed contact approaches after the impact,
+    and each such contact's approach is within that sum over its two bodies (``|omega|`` the
+    faster of before and after), plus the approach the stepping rule counts as rest
+    (`APPROACH`).
+    """
+    problem, outcome = trial.problem, trial.outcome
+    geometry = getattr(problem, "geometry", None)
+    seconds = outcome.diagnostics.get("impact_time")
+    if geometry is None or seconds is None:
+        return False
+    spins = [geometry.body_velocities(v)[:, 3:] for v in (problem.v, outcome.v_plus)]
+    spin = np.maximum(*(np.linalg.norm(w, axis=1) for w in spins))
+    closed = np.flatnonzero(problem.closed)
+    after = gap_rates(problem, outcome.v_plus)
+    rest = APPROACH * float(-np.min(problem.un, initial=0.0))
+    approaching = [j for j in closed if after[j] < 0.0]
+    if not approaching:
+        return False
+    for j in approaching:
+        pair = geometry.pairs[j]
+        swing = 0.0
+        for name in (pair.a, pair.b):
+            k = geometry.index[name]
+            arm = float(np.linalg.norm(np.subtract(pair.point, geometry.bodies[k].position)))
+            swing += spin[k] ** 2 * seconds * arm
+        if -after[j] > swing + rest:
+            return False
+    return True
+
+
+turning_impact = Region(
+    "a closed contact left approaching by no more than its bodies' turning in the engine's "
+    "impact moves its point's velocity (|omega|^2 r T)",
+    _turned,
+)
+
+
+def _misreported(trial: Any) -> bool:
+    """Whether a closed contact approaches after the impact in the outcome but not in the engine.
+
+    The outcome's velocity is the pre-impact one plus the impulses of the forces the engine
+    reports; the engine's own (``engine_v_plus``) is its state after its steps. Where the second
+    leaves every closed contact at rest or separating (within `APPROACH` of the fastest
+    approach) and the first does not, the forces the engine reports miss part of what it applied.
+    """
+    problem, outcome = trial.problem, trial.outcome
+    engine = outcome.diagnostics.get("engine_v_plus")
+    closed = problem.closed
+    if engine is None or not closed.any():
+        return False
+    rest = APPROACH * float(-np.min(problem.un, initial=0.0))
+    own = gap_rates(problem, np.asarray(engine))[closed]
+    return bool(gap_rates(problem, outcome.v_plus)[closed].min() < 0.0 and own.min() >= -rest)
+
+
+misreported_impulse = Region(
+    "a closed contact approaches after the impact by the forces the engine reports, not by its "
+    "own velocity",
+    _misreported,
+)
+
+
+def slopped(slop: float, unsolved: float) -> Region:
+    """Closed contacts left approaching within an engine's contact slop over its step.
+
+    An engine with a contact slop asks a contact only ``d + slop >= 0`` after a step, d its
+    distance, so a closed contact may go on approaching at up to ``slop / dt``; a solver that
+    stops early leaves up to ``unsolved`` of the contact speed (the largest pre-impact normal or
+    tangential contact velocity, the admissibility check's scale) beside it.
+    """
+
+    def contains(trial: Any) -> bool:
+        problem, dt = trial.problem, trial.outcome.diagnostics.get("dt")
+        closed = problem.closed
+        if dt is None or not closed.any():
+            return False
+        speed = float(np.abs(np.concatenate([problem.un[closed], problem.ut])).max())
+        after = float(gap_rates(problem, trial.outcome.v_plus)[closed].min())
+        return after < 0.0 and -after <= slop / dt + unsolved * speed
+
+    return Region(
+        f"a closed contact left approaching slower than the engine's contact slop over the step "
+        f"({slop:g} m / dt)",
+        contains,
+    )
 
 
 def _overlapped(trial: Any) -> bool:

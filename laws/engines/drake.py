@@ -101,9 +101,11 @@ from lawbench.laws.engines._base import (
     damping_for,
     elastic_contact,
     engine_options,
+    misreported_impulse,
     moving_impact,
     overlap_given_back,
     require,
+    turning_impact,
 )
 from lawbench.laws.engines._drake_scene import DrakeScene, Tuning
 
@@ -343,6 +345,31 @@ class Drake(EngineLaw):
             "the bodies: the force along the normal the engine meets has a component along the "
             "problem's frozen tangent, outside the frozen cone (the billiard shot at mu = 0 "
             "takes |Pt| = 0.0035 N s)",
+        ),
+        Claim(
+            "admissible",
+            option("settings", "default") & misreported_impulse,
+            f"{_DOCS}: MultibodyPlant, get_contact_results_output_port (contact results of the "
+            "discrete update)",
+            "at its defaults the outcome's impulses are the contact results Drake reports after "
+            "each step times the step, and at small steps these do not always carry what the "
+            "discrete solver applied: the lamina at dt = 1e-4 s (Drake's own velocity after "
+            "the impact separates the contact at +0.020 m/s) has one step whose reported torque "
+            "about the hinge is 0.018 of the 0.050 the hinge's rate took, so the impulses miss "
+            "3 % of the momentum change and leave the contact approaching at -0.012 m/s; the "
+            "falling rod at dt = 1e-5 s, -7.6e-3 against +1.8e-2",
+        ),
+        Claim(
+            "admissible",
+            option("settings", "default") & turning_impact,
+            f"{_DOCS}: DefaultProximityProperties (point_stiffness 1e6 N/m), MultibodyPlantConfig "
+            "(time_step 1 ms)",
+            "at its defaults a contact is soft, and a body spinning through the impact turns "
+            "while it lasts: the engine lets go where the contact separates at the configuration "
+            "reached, and the gap rate read at the frozen configuration is off by up to "
+            "|omega|^2 r T (the falling rod grazing the floor at 1e-2 m/s with e = 0, spinning at "
+            "3.4 rad/s: un+ = -3.2e-3 m/s after 7 ms, -6.2e-4 after 2.4 ms at dt = 1e-5 s; "
+            "without the spin it leaves separating, +1.7e-3)",
         ),
         *_YARDSTICK,
     )
