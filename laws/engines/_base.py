@@ -36,6 +36,7 @@ from typing import Any, ClassVar
 import numpy as np
 import scipy.optimize
 
+from lawbench.checks.regions import option
 from lawbench.core.errors import SolverFailure
 from lawbench.core.geometry import TOLERANCE, Body, ContactPair, Geometry
 from lawbench.core.guards import held
@@ -218,6 +219,21 @@ def overlap_given_back(source: str, example: str) -> Claim:
         "engine finds it, and the engine's contact gives back the energy of that overlap as it "
         "opens: where the approach covers less than the overlap within a step (a grazing "
         f"approach), that energy is of the order of the impact's or larger ({example})",
+    )
+
+
+def normal_turned(source: str, example: str) -> Claim:
+    """At its defaults an engine's soft impact outlasts the configuration the problem froze.
+
+    The friction-cone finding of `moving_impact`; ``example`` is the measured instance, in words.
+    """
+    return Claim(
+        "friction_cone",
+        option("settings", "default") & moving_impact,
+        source,
+        "at its defaults the impact lasts long enough for the contact's normal to turn with "
+        "the bodies: the force along the normal the engine meets has a component along the "
+        f"problem's frozen tangent, outside the frozen cone ({example})",
     )
 
 
