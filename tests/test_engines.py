@@ -28,7 +28,7 @@ mujoco = pytest.importorskip("mujoco")
 pydrake = pytest.importorskip("pydrake")
 
 # Imported once the engines are known to be installed.
-from lawbench.laws.engines import _base, _bullet_coefficients  # noqa: E402
+from lawbench.laws.engines import _base, _bullet_coefficients, _regions  # noqa: E402
 from lawbench.laws.engines import drake as drake_law  # noqa: E402
 from lawbench.laws.engines import mujoco as mujoco_law  # noqa: E402
 from lawbench.laws.engines import pybullet as pybullet_law  # noqa: E402
@@ -237,7 +237,7 @@ def test_an_engine_gives_back_the_starting_overlap_s_energy_on_a_grazing_approac
     assert str(result.verdict) == "law property"
     assert "starting overlap" in result.claim.region.text
     faster = make_trial(engine, "lamina", params={"e": 0.0}, transform="grazing=1e-06")
-    assert not _base.slower_than_overlap(faster)
+    assert not _regions.slower_than_overlap(faster)
     assert lawbench.run_checks(faster, checks=["energy_gain"])["energy_gain"].passed
 
 
@@ -352,10 +352,10 @@ def test_drake_defaults_leave_a_spinning_body_s_contact_approaching_along_its_fr
     assert (trial.problem.Wn.T @ trial.outcome.v_plus)[0] < -1e-3
     result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
     assert str(result.verdict) == "law property"
-    assert result.claim.region.text.endswith(_base.turning_impact.text)
+    assert result.claim.region.text.endswith(_regions.turning_impact.text)
     still = lawbench.evaluate("drake", "falling_rod", e=0.0, velocities=[2.2, -0.01, 0.0])
     assert (still.problem.Wn.T @ still.outcome.v_plus)[0] > 1e-3
-    assert not _base.turning_impact(still)
+    assert not _regions.turning_impact(still)
 
 
 def test_drake_defaults_report_forces_that_miss_part_of_the_momentum_at_small_steps():
@@ -371,7 +371,7 @@ def test_drake_defaults_report_forces_that_miss_part_of_the_momentum_at_small_st
     assert (trial.problem.Wn.T @ trial.outcome.v_plus)[0] == pytest.approx(-0.012, abs=1e-3)
     result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
     assert str(result.verdict) == "law property"
-    assert result.claim.region.text.endswith(_base.misreported_impulse.text)
+    assert result.claim.region.text.endswith(_regions.misreported_impulse.text)
     coarse = make_trial("drake", "lamina", judged=False).outcome
     assert coarse.diagnostics["engine_velocity_gap"] < 1e-4
 

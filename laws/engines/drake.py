@@ -99,16 +99,18 @@ from lawbench.laws.engines._base import (
     Scene,
     Start,
     damping_for,
-    elastic_contact,
     engine_options,
+    require,
+)
+from lawbench.laws.engines._drake_scene import DrakeScene, Tuning
+from lawbench.laws.engines._regions import (
+    elastic_contact,
     misreported_impulse,
     moving_impact,
     normal_turned,
     overlap_given_back,
-    require,
     turning_impact,
 )
-from lawbench.laws.engines._drake_scene import DrakeScene, Tuning
 
 require("pydrake")
 

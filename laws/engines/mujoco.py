@@ -74,14 +74,16 @@ from lawbench.laws.engines._base import (
     Scene,
     Start,
     damping_for,
-    elastic_contact,
     engine_options,
-    moving_impact,
-    normal_turned,
-    overlap_given_back,
     plane_axes,
     quietly,
     require,
+)
+from lawbench.laws.engines._regions import (
+    elastic_contact,
+    moving_impact,
+    normal_turned,
+    overlap_given_back,
 )
 
 require("mujoco")

@@ -87,11 +87,13 @@ from lawbench.laws.engines._base import (
     pair_of,
     quietly,
     require,
-    slopped,
 )
 from lawbench.laws.engines._bullet_coefficients import MAX_FRICTION, body_coefficients
 from lawbench.laws.engines._bullet_coefficients import means as body_means
 from lawbench.laws.engines._bullet_shapes import SIZES, ellipsoid_points
+from lawbench.laws.engines._regions import (
+    slopped,
+)
 
 require("pybullet")
 
