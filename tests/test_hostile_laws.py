@@ -191,13 +191,28 @@ def _hides_a_tensile_impulse(self, problem, options):
     return dataclasses.replace(outcome, Pn=np.abs(outcome.Pn))
 
 
+def _answers_another_problem(self, problem, options):
+    faster = lawbench.ImpactProblem.from_arrays(np.eye(1), [[1.0]], [-4.0], e=1.0)
+    return lawbench.Outcome.from_impulses(faster, np.array([8.0]))
+
+
+@pytest.mark.parametrize("module", [__name__, "lawbench.laws.own_test_law"])
 @pytest.mark.parametrize(
     ("body", "said"),
-    [(_reports_less_energy, "T_plus = 1 J"), (_hides_a_tensile_impulse, "impulses")],
+    [
+        (_reports_less_energy, "T_plus = 1 J"),
+        (_hides_a_tensile_impulse, "impulses"),
+        (_answers_another_problem, "reports T_minus"),
+    ],
 )
-def test_reported_numbers_must_be_those_of_the_velocities(body, said):
+def test_reported_numbers_must_be_those_of_the_velocities(body, said, module):
+    """Also for lawbench's own laws, whose outcomes `Outcome.from_impulses` built from the
+    problem solved are taken as consistent: a copy with other numbers, or an outcome built
+    from another problem, is read number by number."""
+    law = broken(body)
+    type(law).__module__ = module
     with pytest.raises(SolverFailure, match=said):
-        lawbench.solve(broken(body), ball(e=1.0))
+        lawbench.solve(law, ball(e=1.0))
 
 
 def test_the_checks_read_the_velocities_not_the_reports():

@@ -112,9 +112,23 @@ class Outcome:
     ) -> Outcome:
         """Build the outcome of applying impulses ``Pn`` (and ``Pt``) to ``problem``.
 
-        ``fields`` are the optional fields (status, diagnostics, path).
+        ``fields`` are the optional fields (status, diagnostics, path). The outcome agrees
+        with its impulses by construction: `impulses_of` says so for ``problem``.
         """
-        return cls.from_velocity(problem, velocity_after(problem, Pn, Pt), Pn, Pt, **fields)
+        outcome = cls.from_velocity(problem, velocity_after(problem, Pn, Pt), Pn, Pt, **fields)
+        # The problem's identity, not the problem: an outcome pickles without its problem.
+        object.__setattr__(outcome, "_impulses_of", id(problem))
+        return outcome
+
+    def impulses_of(self, problem: ImpactProblem) -> bool:
+        """Whether `from_impulses` built this very outcome from ``problem``.
+
+        Its velocity is then the impulses' and its energies the velocity's, by construction.
+        A copy made with `dataclasses.replace` is not that outcome, nor is one built from an
+        earlier problem whose identity ``problem`` took over after it was freed: the answer
+        holds for an outcome built while ``problem`` is alive.
+        """
+        return self.__dict__.get("_impulses_of") == id(problem)
 
     @classmethod
     def from_velocity(
