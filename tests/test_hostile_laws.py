@@ -8,6 +8,7 @@ velocities do not hold.
 
 import dataclasses
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -28,6 +29,7 @@ from lawbench.core.law import Law
 from lawbench.core.registry import Registry
 from lawbench.core.trial import Trial
 from lawbench.views.cli.main import main
+from lawbench.views.cli.solve import plain
 
 SHORT = lawbench.Spec("max_seconds", 0.3, "wall-clock budget of one solve", unit="s", low=0.0)
 
@@ -192,8 +194,8 @@ def _hides_a_tensile_impulse(self, problem, options):
 
 
 def _answers_another_problem(self, problem, options):
-    faster = lawbench.ImpactProblem.from_arrays(np.eye(1), [[1.0]], [-4.0], e=1.0)
-    return lawbench.Outcome.from_impulses(faster, np.array([8.0]))
+    heavier = lawbench.ImpactProblem.from_arrays(2 * np.eye(1), [[1.0]], [-2.0], e=1.0)
+    return lawbench.Outcome.from_impulses(heavier, np.array([8.0]))
 
 
 @pytest.mark.parametrize("module", [__name__, "lawbench.laws.own_test_law"])
@@ -213,6 +215,65 @@ def test_reported_numbers_must_be_those_of_the_velocities(body, said, module):
     type(law).__module__ = module
     with pytest.raises(SolverFailure, match=said):
         lawbench.solve(law, ball(e=1.0))
+
+
+def _replaced(**fields):
+    def body(self, problem, options):
+        return dataclasses.replace(Plain._resolve(self, problem, options), **fields)
+
+    return body
+
+
+def _raises(error):
+    def body(self, problem, options):
+        raise error
+
+    return body
+
+
+@pytest.mark.parametrize(
+    ("body", "said"),
+    [
+        (_replaced(v_plus=np.array([1.0 + 0j])), "v_plus holds complex128, not floats"),
+        (_replaced(Pn=[3.0]), "Pn is a list, not an array"),
+        (_replaced(T_plus=1j), "T_plus is a complex, not a real number"),
+        (_replaced(status="ok\nfine"), "is not one word"),
+        (_replaced(diagnostics=[1]), "diagnostics is a list, not a dict"),
+        (_replaced(v_minus=np.array([7.0])), "v_minus is not the problem's velocity"),
+        (_raises(RecursionError("deep")), "the law raised RecursionError: deep"),
+        (_raises(GeneratorExit()), "the law raised GeneratorExit"),
+        (_raises(type("Odd", (BaseException,), {})()), "the law raised Odd"),
+    ],
+    ids=[
+        "complex",
+        "list",
+        "complex-energy",
+        "status",
+        "diagnostics",
+        "v_minus",
+        "raises",
+        "generator-exit",
+        "base-exception",
+    ],
+)
+def test_a_malformed_answer_or_a_raise_is_a_failure_of_that_law(body, said):
+    """What the tables, the checks and the JSON output read is of the kind they read, and an
+    exception out of a law is that law's failure, never an internal error."""
+    with pytest.raises(SolverFailure, match=re.escape(said)):
+        lawbench.solve(broken(body), ball())
+
+
+def test_an_error_raised_by_lawbench_s_own_law_stays_an_internal_error():
+    """A bug of lawbench's own is not passed off as a solver's failure."""
+    own = broken(_raises(RecursionError("deep")))
+    type(own).__module__ = "lawbench.laws.own_test_law"
+    with pytest.raises(RecursionError):
+        lawbench.solve(own, ball())
+
+
+def test_the_json_record_holds_what_json_has_no_type_for_as_text():
+    record = plain({"s": {1}, "z": 1j, "nan": float("nan"), "f": np.float64(2.0), "n": None})
+    assert record == {"s": "{1}", "z": "1j", "nan": None, "f": 2.0, "n": None}
 
 
 def test_the_checks_read_the_velocities_not_the_reports():
@@ -271,6 +332,7 @@ HOSTILE = '''
 """Laws that misbehave, for the command-line tests of lawbench's guards."""
 
 import signal
+import threading
 import time
 
 import numpy as np
@@ -286,6 +348,15 @@ class Sleeper(lawbench.Law):
 
     def _resolve(self, problem, options):
         time.sleep(1000)
+
+
+class Spawner(Sleeper):
+    name = "spawner"
+    summary = "answers, and leaves a thread running that the interpreter would wait for"
+
+    def _resolve(self, problem, options):
+        threading.Thread(target=time.sleep, args=(1000,)).start()
+        return lawbench.Outcome.from_impulses(problem, -1.5 * problem.un / problem.delassus[0])
 
 
 class Deaf(Sleeper):
@@ -317,6 +388,7 @@ ENTRY_POINTS = """
 [lawbench.laws]
 sleeper = hostile_plugin:Sleeper
 deaf = hostile_plugin:Deaf
+spawner = hostile_plugin:Spawner
 exits = exits_at_import:Nothing
 interrupts = interrupts_at_import:Nothing
 
@@ -363,6 +435,12 @@ def test_solve_stops_a_law_that_never_answers(hostile_env, law):
     assert done.returncode == 4, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and WALL_CLOCK in done.stderr
     assert time.monotonic() - start < 20
+
+
+def test_solve_ends_when_a_law_left_a_thread_running(hostile_env):
+    done = cli(hostile_env, "solve", "spawner", "lone_ball")
+    assert done.returncode == 0, done.stderr
+    assert "status: ok" in done.stdout
 
 
 def test_main_called_as_a_function_never_ends_its_callers_process(capsys):

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import signal
 import threading
 import time
@@ -44,6 +45,8 @@ from lawbench.core.metric import all_finite
 from lawbench.core.outcome import Outcome, generalized_impulse
 from lawbench.core.problem import ImpactProblem
 
+# What an outcome's energies may be: real numbers (a bool is none).
+REAL = (int, float, np.integer, np.floating)
 # The budget that a stop from outside the solve names.
 WALL_CLOCK = "wall-clock guard"
 
@@ -292,6 +295,7 @@ def verify_answer(law: str, problem: ImpactProblem, outcome: Any, own: bool = Fa
                 raise SolverFailure(f"{law}: {field} has shape {shape}, expected ({length},)")
     if own and outcome.impulses_of(problem) and math.isfinite(outcome.T_plus):
         return
+    _refuse_malformed(law, problem, outcome)
     before, after = problem.momentum, problem.M.dot(v_plus)
     impulse = generalized_impulse(problem, Pn, Pt)
     residual = impulse - after + before
@@ -313,6 +317,34 @@ def verify_answer(law: str, problem: ImpactProblem, outcome: Any, own: bool = Fa
         raise SolverFailure(
             f"{law}: its impulses Wn Pn + Wt Pt do not give its velocity change M (v+ - v-)"
         )
+
+
+def _refuse_malformed(law: str, problem: ImpactProblem, outcome: Outcome) -> None:
+    """Raise `SolverFailure` for a field of the wrong kind.
+
+    The velocity and impulses are arrays of floats, the energies real numbers, the status one
+    word, the diagnostics a dict, and ``v_minus`` (where given) the problem's velocity: what the
+    checks, the tables and the JSON output read.
+    """
+    for field in ("v_plus", "Pn", "Pt"):
+        value = getattr(outcome, field)
+        if not isinstance(value, np.ndarray):
+            raise SolverFailure(f"{law}: {field} is a {type(value).__name__}, not an array")
+        if value.dtype.kind != "f":
+            raise SolverFailure(f"{law}: {field} holds {value.dtype}, not floats")
+    for field in ("T_minus", "T_plus"):
+        value = getattr(outcome, field)
+        if isinstance(value, bool) or not isinstance(value, REAL):
+            raise SolverFailure(f"{law}: {field} is a {type(value).__name__}, not a real number")
+    if not isinstance(outcome.status, str) or not re.fullmatch(r"\w+", outcome.status):
+        raise SolverFailure(f"{law}: status {outcome.status!r} is not one word")
+    if not isinstance(outcome.diagnostics, dict):
+        kind = type(outcome.diagnostics).__name__
+        raise SolverFailure(f"{law}: diagnostics is a {kind}, not a dict")
+    v_minus = outcome.v_minus
+    if v_minus is not None and v_minus is not problem.v:
+        if np.shape(v_minus) != problem.v.shape or not np.array_equal(v_minus, problem.v):
+            raise SolverFailure(f"{law}: v_minus is not the problem's velocity v")
 
 
 def refuse_non_finite(name: str, **fields: Any) -> None:

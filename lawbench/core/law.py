@@ -51,7 +51,13 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from lawbench.core.contact import ContactProblem, ContactSolution
-from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.errors import (
+    BudgetExceeded,
+    InvalidProblem,
+    LawbenchError,
+    NotApplicable,
+    SolverFailure,
+)
 from lawbench.core.guards import (
     from_user,
     inputs,
@@ -391,6 +397,14 @@ class Law(ABC):
             raise SolverFailure(f"{self.name}: the law called sys.exit({exc.code!r})") from None
         except MemoryError:
             raise SolverFailure(f"{self.name}: out of memory (MemoryError)") from None
+        except LawbenchError:
+            raise
+        except Exception as exc:
+            if not checksum:  # a bug of lawbench's own: an internal error, said as one
+                raise
+            raise SolverFailure(f"{self.name}: the law raised {_named(exc)}") from None
+        except BaseException as exc:  # neither an error nor a stop: GeneratorExit, its own
+            raise SolverFailure(f"{self.name}: the law raised {_named(exc)}") from None
         now = inputs(problem, options, checksum)
         if now != given:
             what = "problem" if now[0] != given[0] else "options"
@@ -560,6 +574,12 @@ def _without_negligible_friction(problem: ImpactProblem) -> tuple[ImpactProblem,
         for j, c in enumerate(problem.contacts)
     ]
     return dataclasses.replace(problem, contacts=contacts), negligible
+
+
+def _named(exc: BaseException) -> str:
+    """``Type: message`` of an exception, or its type alone when it says nothing."""
+    said = str(exc)
+    return f"{type(exc).__name__}: {said}" if said else type(exc).__name__
 
 
 # The warnings filter that shows every warning, each time (`warnings.simplefilter`'s entry).
