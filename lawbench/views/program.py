@@ -8,12 +8,15 @@ Python's reach: OpenBLAS, unable to map its buffers, loops without end, exits, o
 with a traceback. So `program` first reserves, and gives back, the address space those
 libraries map as they load (`lawbench.views.room`); where the limit leaves less, or a
 MemoryError or an unmappable library still stops the start, it says so in one line with a
-solver failure's exit code, 4: the work needs more memory than it was given.
+solver failure's exit code, 4: the work needs more memory than it was given. A command
+that is over ends its process, even where a law left a thread running.
 """
 
 from __future__ import annotations
 
+import os
 import sys
+import threading
 
 from lawbench.views.room import room_to_start, unmappable
 
@@ -36,7 +39,25 @@ def program() -> int:
         if unmappable(exc):
             return _refuse(f"lawbench: out of memory while starting ({_cause(exc)})", OUT_OF_MEMORY)
         return _refuse(f"lawbench: internal error: cannot start: {_cause(exc)}", INTERNAL)
-    return main(own_process=True)
+    code = main(own_process=True)
+    if _left_running():
+        # A plugin left a thread running: the command is over, and so is its process.
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                if stream is not None:
+                    stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(code)
+    return code
+
+
+def _left_running() -> bool:
+    """Whether a thread that the interpreter would wait for at its exit is still running."""
+    return any(
+        thread is not threading.main_thread() and not thread.daemon and thread.is_alive()
+        for thread in threading.enumerate()
+    )
 
 
 def _cause(exc: BaseException) -> str:

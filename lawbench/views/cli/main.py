@@ -250,7 +250,7 @@ def main(argv: Sequence[str] | None = None, *, own_process: bool = False) -> int
     _escaping_streams()
     try:
         code = _main(argv, own_process)
-        if sys.stdout is not None:
+        if sys.stdout is not None and not sys.stdout.closed:
             sys.stdout.flush()  # a full device fails here, not in the interpreter's exit
     except BrokenPipeError:
         _silence_stdout()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from collections.abc import Sequence
 from typing import Any
@@ -173,7 +174,11 @@ def _numbers(values: Sequence[float]) -> str:
 
 
 def plain(value: Any) -> Any:
-    """Return ``value`` with numpy arrays and scalars turned into lists, floats and ints."""
+    """Return ``value`` as JSON holds it: numpy arrays and scalars as lists, floats and ints.
+
+    A number that is not finite is null (JSON has none); anything JSON has no type for (a set,
+    a complex number, an object a plugin left in its diagnostics) is its text.
+    """
     if isinstance(value, dict):
         return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
@@ -181,8 +186,12 @@ def plain(value: Any) -> Any:
     if isinstance(value, np.ndarray):
         return plain(value.tolist())
     if isinstance(value, np.generic):
-        return value.item()
-    return value
+        return plain(value.item())
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if value is None or isinstance(value, str | int):
+        return value
+    return str(value)
 
 
 def trial_record(trial: Trial, checks: dict[str, CheckResult]) -> dict[str, Any]:
