@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core.law import LAWS, Law, current_budget
+from lawbench.core.budget import current_budget
+from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.core.spec import Spec

@@ -7,15 +7,14 @@ checks the options and the problem against the tags, restricts the problem to it
 units near it and scales the answer back (`ImpactProblem.units`), times the solve within the
 budget its options set, and refuses to return a non-finite answer.
 
-The budget is what one solve may spend: steps, events and wall-clock seconds, one mechanism for
-every law. `Law.resolve` opens a `Budget` (a context manager) from the law's options for the
-time of the solve: ``max_seconds`` (every law has it), ``max_steps`` (a law that steps:
-integrator steps, fixed-point iterations, binary impacts) and ``max_events`` (a law that
-restarts at events), each when the law declares it. The law's loops spend from
-`current_budget()` (the event integrator of `lawbench.numerics.integrator` does it for the
-integrating laws; an iterative solver calls `Budget.step` once per iteration), and a budget that
-runs out raises `BudgetExceeded` naming the option, its amount and the seconds spent, which is
-what a budget cell of a table shows. `lawbench.core.guards.alarm` stops from outside a solve
+The budget is what one solve may spend (`lawbench.core.budget`): `Law.resolve` opens a `Budget`
+from the law's options for the time of the solve: ``max_seconds`` (every law has it),
+``max_steps`` (a law that steps: integrator steps, fixed-point iterations, binary impacts) and
+``max_events`` (a law that restarts at events), each when the law declares it. The law's loops
+spend from `current_budget()` (the event integrator of `lawbench.numerics.integrator` does it for
+the integrating laws; an iterative solver calls `Budget.step` once per iteration), and a budget
+that runs out raises `BudgetExceeded` naming the option, its amount and the seconds spent, which
+is what a budget cell of a table shows. `lawbench.core.guards.alarm` stops from outside a solve
 that ignores its own (`lawbench.core.trial.make_trial` sets it).
 
 A law is code from anywhere, so `Law.resolve` holds every answer of `Law._resolve` to what the
@@ -38,21 +37,16 @@ budget, timing and refusal of non-finite answers. The other laws refuse such a p
 
 from __future__ import annotations
 
-import contextvars
 import dataclasses
 import functools
-import math
-import time
-import warnings
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from lawbench.core.budget import Watch
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import (
-    BudgetExceeded,
     InvalidProblem,
     LawbenchError,
     NotApplicable,
@@ -93,105 +87,6 @@ OWN_PACKAGE = "lawbench."
 MAX_SECONDS = Spec(
     "max_seconds", 60.0, "wall-clock budget of one solve", unit="s", low=0.0, low_open=True
 )
-
-
-class Budget:
-    """Steps, events and seconds one solve of law ``law`` may spend.
-
-    Parameters
-    ----------
-    law : str
-        The law's name, for the messages.
-    max_seconds : float
-        Wall-clock seconds from now.
-    max_steps, max_events : int or None
-        Counts of steps and of events; None for no bound.
-    """
-
-    def __init__(
-        self,
-        law: str,
-        max_seconds: float = math.inf,
-        max_steps: int | None = None,
-        max_events: int | None = None,
-    ) -> None:
-        self.law, self.max_seconds = law, max_seconds
-        self.max_steps, self.max_events = max_steps, max_events
-        self.steps = self.events = 0
-        self.start = time.monotonic()
-
-    @classmethod
-    def of(cls, law: str, options: Mapping[str, Any]) -> Budget:
-        """The budget a law's checked ``options`` set (the ones it declares)."""
-        return cls(
-            law,
-            options.get("max_seconds", math.inf),
-            options.get("max_steps"),
-            options.get("max_events"),
-        )
-
-    @property
-    def spent_s(self) -> float:
-        """Seconds since the budget was opened."""
-        return time.monotonic() - self.start
-
-    @property
-    def seconds_left(self) -> float:
-        """Seconds left before ``max_seconds`` runs out (never negative)."""
-        return max(self.max_seconds - self.spent_s, 0.0)
-
-    def step(self, what: str = "steps", note: str = "") -> None:
-        """Spend one step and check the time.
-
-        ``what`` names the steps in the message, ``note`` says where the method stood.
-        """
-        self.steps += 1
-        if self.max_steps is not None and self.steps > self.max_steps:
-            where = f"; {note}" if note else ""
-            self._exceeded(f"step budget ran out ({self.max_steps} {what}{where}", "max_steps")
-        self.check_time()
-
-    def event(self, what: str = "events") -> None:
-        """Spend one event and check the time."""
-        self.events += 1
-        if self.max_events is not None and self.events > self.max_events:
-            self._exceeded(f"event budget ran out ({self.max_events} {what}", "max_events")
-        self.check_time()
-
-    def check_time(self) -> None:
-        """Raise once ``max_seconds`` have passed."""
-        if self.spent_s > self.max_seconds:
-            self.out_of_time()
-
-    def out_of_time(self) -> None:
-        """Raise the time budget's `BudgetExceeded` (a solver given `seconds_left` stopped)."""
-        self._exceeded(f"time budget ran out ({self.max_seconds:g} s", "max_seconds")
-
-    def _exceeded(self, what: str, option: str) -> None:
-        amount = {
-            "max_steps": self.max_steps,
-            "max_events": self.max_events,
-            "max_seconds": self.max_seconds,
-        }[option]
-        # The seconds spent go with the error, not into its message: messages are
-        # deterministic, and a table groups its failed cells by message.
-        raise BudgetExceeded(f"{self.law}: {what}, {option})", option, amount, self.spent_s)
-
-    def __enter__(self) -> Budget:
-        """Open the budget: `current` gives it inside the block (blocks nest)."""
-        self._token = _OPEN.set(self)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        _OPEN.reset(self._token)
-
-
-_OPEN: contextvars.ContextVar[Budget | None] = contextvars.ContextVar("budget", default=None)
-
-
-def current_budget() -> Budget:
-    """The budget of the solve under way; an unbounded one outside any solve."""
-    return _OPEN.get() or Budget("lawbench")
 
 
 class Law(ABC):
@@ -347,7 +242,7 @@ class Law(ABC):
             problem = problem.dense()
         units = problem.units if self.scale_free else (1.0, 1.0, 1.0)
         solved = problem if units == (1.0, 1.0, 1.0) else problem.in_units(*units)
-        with _Watch(self.name, values) as watch:
+        with Watch(self.name, values) as watch:
             outcome = self._resolve_closed(solved, values)
         if solved is not problem:
             outcome = scaled_back(outcome, problem, units)
@@ -463,7 +358,7 @@ class Law(ABC):
                 f"{self.name}: resolves impacts in generalized coordinates; a contact-space "
                 "problem (FCLIB's local form: W, q and mu only) has none"
             )
-        with _Watch(self.name, values) as watch:
+        with Watch(self.name, values) as watch:
             r, diagnostics = self._solve_contact(problem, values)
         refuse_non_finite(self.name, r=r)
         diagnostics.update(watch.record, W_asymmetry=problem.asymmetry)
@@ -505,7 +400,7 @@ class Law(ABC):
         batch = _batch_without_negligible_friction(batch)
         # Problems of extreme scale are rescaled one by one, by `resolve`.
         scaled = self.scale_free and not batch.in_own_units
-        with _Watch(self.name, values) as watch:
+        with Watch(self.name, values) as watch:
             answer = None if scaled else self._resolve_batch(batch, values)
             result = self._completed(batch, answer, values)
         refuse_non_finite(self.name, v_plus=result.v_plus)
@@ -580,43 +475,6 @@ def _named(exc: BaseException) -> str:
     """``Type: message`` of an exception, or its type alone when it says nothing."""
     said = str(exc)
     return f"{type(exc).__name__}: {said}" if said else type(exc).__name__
-
-
-# The warnings filter that shows every warning, each time (`warnings.simplefilter`'s entry).
-_ALWAYS = ("always", None, Warning, None, 0)
-
-
-class _Watch:
-    """What every solve shares: its budget, its wall time, and the warnings it raised.
-
-    Opened around a law's own solve, it opens the `Budget` the checked ``options`` set
-    and records every warning instead of printing it. ``record`` then holds ``options``,
-    ``wall_time_s`` and, where the solve raised any, ``warnings``, for the answer's diagnostics.
-    """
-
-    def __init__(self, law: str, options: dict[str, Any]) -> None:
-        self.budget = Budget.of(law, options)
-        self.warnings = warnings.catch_warnings(record=True)
-        self.record: dict[str, Any] = {"options": options}
-
-    def __enter__(self) -> _Watch:
-        self.budget.__enter__()
-        self.caught = self.warnings.__enter__()
-        # Every warning recorded, none printed: the filter "always" ahead of the caller's, in
-        # the copy of the filters the block has. Put there before any warning is issued under
-        # that copy, it needs no reset of the registries of warnings already shown (which
-        # `warnings.simplefilter` would do, at half the cost of a small solve).
-        warnings.filters.insert(0, _ALWAYS)
-        self.start = time.perf_counter()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.record["wall_time_s"] = time.perf_counter() - self.start
-        self.warnings.__exit__(*exc)
-        self.budget.__exit__(*exc)
-        if self.caught:
-            heard = {f"{w.category.__name__}: {w.message}" for w in self.caught}
-            self.record["warnings"] = sorted(heard)
 
 
 LAWS: Registry[Law] = Registry("law", "lawbench.laws", Law)

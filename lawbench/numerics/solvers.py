@@ -30,8 +30,8 @@ import scipy.optimize
 import scipy.sparse
 import scipy.sparse.linalg
 
+from lawbench.core.budget import current_budget
 from lawbench.core.errors import SolverFailure
-from lawbench.core.law import current_budget
 from lawbench.core.metric import SPARSE_SHARE, as_array, is_diagonal, is_sparse
 
 ROUNDING = 1e-12

@@ -125,9 +125,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from lawbench.checks.regions import option, separating_contact
+from lawbench.core.budget import current_budget
 from lawbench.core.contact import ContactProblem
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
-from lawbench.core.law import LAWS, Law, current_budget
+from lawbench.core.law import LAWS, Law
 from lawbench.core.metric import as_array
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
