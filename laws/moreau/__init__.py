@@ -436,14 +436,13 @@ def _approaching(u: np.ndarray, m: int, tol: float, scale: float) -> bool:
 def _leaving(problem: ContactProblem, r: np.ndarray, tol: float) -> np.ndarray:
     """``r`` when no contact approaches after it (`_approaching`), else the exact state.
 
-    The FC3D error cannot see an approaching contact whose ``un`` the modified velocity lost
-    to rounding (``mu`` near 1e300), nor one of an answer grown far beyond ``q`` on a ``W``
-    that is not positive definite: the normal law is checked on ``u`` itself.
+    Each method stops at its own test; the normal law is checked here on ``u`` itself, against
+    velocities only, so that no size of impulses (``W`` of 1e-100, impulses of 1e100) and no
+    ``mu`` near 1e300 (whose modified velocity loses ``un`` to rounding) hides an approach.
     """
     u = problem.velocity(r)
-    # The scale the FC3D error is normalized by (Siconos' max of |q|, |r| and |u|): an answer
-    # within its tolerance may leave un that far below zero, in the measure's mixed units.
-    scale = max(float(np.abs(problem.q).max()), float(np.abs(r).max()), float(np.abs(u).max()))
+    # Velocities only: impulses, in other units, would make any approach look small.
+    scale = max(float(np.abs(problem.q).max()), float(np.abs(u).max()))
     if not _approaching(u[:: problem.dim], problem.m, tol, scale):
         return r
     return _one_contact_or_refuse(problem.W.toarray(), problem.q, problem.mu)
