@@ -16,6 +16,7 @@ if TYPE_CHECKING:
 # Rows beyond which a CSR product beats a dense one on a banded matrix: below, the sparse
 # product's dispatch costs more than the arithmetic it saves.
 SPARSE_PRODUCTS = 200
+EPS = float(np.finfo(float).eps)
 
 
 def separating_contacts(problem: ImpactProblem) -> list[int]:
@@ -109,23 +110,29 @@ def fc3d_error(W: np.ndarray, q: np.ndarray, mu: np.ndarray, r: np.ndarray) -> f
     (``W * s``, ``q * s``), contact by contact: impulses of 1e100 cannot dilute it. The
     approaches are counted apart because the natural map sees one only through the dual cone
     ``mu |w_T| <= w_N``, whose aperture shrinks as ``1 / mu``: at ``mu = 1e6`` a contact
-    approaching at 1 moves ``uhat`` by 1e-6 from it. Zero exactly at a solution; ``inf`` when
-    ``r``, ``u`` or the modified velocity holds a number that is not finite: no tolerance
-    accepts that answer. Norms are taken with their entries scaled by the largest first, so
-    that none overflows.
+    approaching at 1 moves ``uhat`` by 1e-6 from it. A local velocity is known to its rounding,
+    ``dim eps (|W| |r| + |q|)`` row by row, and is given it: the modified velocity multiplies
+    the rounding of a sticking contact's ``|u_T|`` by ``mu``, which at ``mu = 1e6`` made an
+    error of 1e-10 of two roundings of one ``W`` (a global form's ``H.T M^-1 H`` and the
+    impact's ``Wc.T M^-1 Wc``), below which no solver's tolerance could be met. Zero exactly
+    at a solution; ``inf`` when ``r``, ``u``, the modified velocity or the rounding holds a
+    number that is not finite: no tolerance accepts that answer. Norms are taken with their
+    entries scaled by the largest first, so that none overflows.
     """
     with np.errstate(over="ignore", invalid="ignore"):
         u = W @ r + q
         dim = r.size // len(mu)
         uj = u.reshape(-1, dim)
+        rounding = (dim * EPS * (abs(W) @ np.abs(r) + np.abs(q))).reshape(-1, dim)
         z = np.asarray(W.diagonal())[::dim, None] * r.reshape(-1, dim)
         x = z - uj
-        x[:, 0] -= mu * _norms(uj[:, 1:])
-    if not (np.isfinite(x).all() and np.isfinite(z).all()):
+        x[:, 0] -= mu * np.maximum(_norms(uj[:, 1:]) - _norms(rounding[:, 1:]), 0.0)
+    if not (np.isfinite(x).all() and np.isfinite(z).all() and np.isfinite(rounding).all()):
         return math.inf
     with np.errstate(over="ignore"):  # mu * mu of mu near 1e300: the projection is then 0
         projected = project_all(x, mu)
-    residual = np.concatenate([(z - projected).ravel(), np.minimum(uj[:, 0], 0.0)])
+    approach = np.minimum(uj[:, 0] + rounding[:, 0], 0.0)
+    residual = np.concatenate([(z - projected).ravel(), approach])
     error = _norm(residual)
     scale = max(_norm(np.asarray(q, dtype=float)), _norm(u))
     return error / scale if scale > 0.0 else error
