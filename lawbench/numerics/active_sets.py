@@ -67,7 +67,10 @@ def _pivoted(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarray | N
     """
     fewest, stalls = len(q) + 1, 0
     for _ in range(PIVOTS_PER_CONTACT * len(q)):
-        z = _on_independent(G, q, np.flatnonzero(active))
+        try:
+            z = _on_independent(G, q, np.flatnonzero(active))
+        except (np.linalg.LinAlgError, ValueError):
+            return None
         w = G @ z + q
         allowed = 1e-10 * max(float(np.abs(q).max()), ROUNDING) + ROUNDING * (abs(G) @ np.abs(z))
         wrong = (active & (np.asarray(G.diagonal()) * z < -allowed)) | (~active & (w < -allowed))
@@ -88,7 +91,7 @@ def _on_independent(G: np.ndarray, q: np.ndarray, rows: np.ndarray) -> np.ndarra
     z = np.zeros_like(q)
     if rows.size:
         keep = rows[_independent(G[np.ix_(rows, rows)])]
-        z[keep] = scipy.linalg.solve(G[np.ix_(keep, keep)], -q[keep], assume_a="sym")
+        z[keep] = _solve_block(G[np.ix_(keep, keep)], -q[keep])
     return z
 
 
