@@ -12,6 +12,7 @@ import scipy.sparse
 
 import lawbench
 from lawbench import ContactProblem, InvalidProblem
+from lawbench.core.mechanics import fc3d_error
 
 # One contact, by hand: W = diag(2, 1, 1), q = (-1, 3, 4), mu = 1/2 slips against (3, 4):
 # r = (1/2, -(1/4) (3, 4) / 5), u = (0, 3 - 3/20, 4 - 4/20).
@@ -85,3 +86,34 @@ def test_a_fixed_point_that_settles_above_tol_fails_saying_where():
     assert moreau.solve_contact(problem).fc3d_error <= 1e-10
     with pytest.raises(lawbench.SolverFailure, match=r"settled after 1 cone QPs at FC3D error"):
         moreau.solve_contact(problem, tol=1e-300)
+
+
+def test_the_fc3d_error_is_free_of_units_and_counts_every_approach():
+    """Impulses of 1e100 against a W of 1e-100 are measured like impulses of 1 against a W of
+    1, and velocities in any unit alike: an answer leaving the contact approaching at half its
+    speed is as wrong in every unit. At mu = 1e6 the dual cone is so narrow that the natural
+    map sees an approach of 1 as a shift of 1e-6; the approach itself is counted."""
+    W, q, mu = np.eye(3), np.array([-1.0, 0.0, 0.0]), np.array([0.3])
+    half = np.array([0.5, 0.0, 0.0])
+    base = fc3d_error(W, q, mu, half)
+    assert base > 0.3
+    for s in (1e-100, 1e100):
+        assert fc3d_error(W / s, q, mu, half * s) == pytest.approx(base, rel=1e-12)
+        assert fc3d_error(W * s, q * s, mu, half) == pytest.approx(base, rel=1e-12)
+    sliding = np.array([-1.0, 1.0, 0.0])
+    assert fc3d_error(W, sliding, np.array([1e6]), np.zeros(3)) > 0.5
+
+
+@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize("method", ["auto", "nsgs", "fixed_point"])
+def test_a_rank_one_delassus_matrix_leaving_contacts_approaching_is_refused(seed, method):
+    """W = 1e-100 b b.T over three contacts with mu = 1e6: one impulse direction cannot stop
+    three approaching contacts, and the answers the sweeps stopped at (impulses of 1e100,
+    contacts approaching at their full speed) had an FC3D error of 1e-19 and less, relative to
+    impulses in other units than the velocities. They are refused."""
+    rng = np.random.default_rng(seed)
+    b, q = rng.normal(size=9), rng.normal(size=9)
+    q[0::3] = -np.abs(q[0::3]) - 0.5
+    problem = ContactProblem(1e-100 * np.outer(b, b), q, np.full(3, 1e6))
+    with pytest.raises(lawbench.SolverFailure):
+        lawbench.LAWS["moreau"].solve_contact(problem, method=method, max_steps=50)

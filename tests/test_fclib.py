@@ -8,7 +8,9 @@ against global problems that Siconos and LMGC90 wrote (``tests/data/fclib``), so
 only held to our own writer.
 """
 
+import dataclasses
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -17,6 +19,7 @@ import numpy as np
 import pytest
 
 import lawbench
+from lawbench import Contact
 from lawbench.files.fclib import read_fclib, write_fclib
 from lawbench.files.problem_files import read_problem
 
@@ -218,7 +221,9 @@ SOLVED = [path for path in LOCAL if path.stem in AS_GIVEN]
 def test_local_problems_from_siconos_and_lmgc90_are_solved_as_given(path):
     """The local files Siconos and LMGC90 wrote are solved on their own W and q, read here with
     h5py in compressed rows (nz = -2), not with the reader under test: De Saxce's conditions
-    hold, and the FC3D error is at most 1e-8. The PerioBox file's q has a part outside the range
+    hold, the FC3D error is at most 1e-8, and so is every approach (relative to |q|; impulses
+    of 1e5 against a W of 1e-5 once let an answer leave a contact approaching at 4e-3 of |q|
+    pass). The PerioBox file's q has a part outside the range
     of W (27 % of |q|: W has rank 72 of 180), which no factorization W = Wc.T Wc with
     q = Wc.T v can represent; the Capsules file's W is asymmetric by 1.3e-3, which the solve
     reports and keeps."""
@@ -240,6 +245,7 @@ def test_local_problems_from_siconos_and_lmgc90_are_solved_as_given(path):
         read_fclib(path), method="nsgs", tol=1e-8, max_steps=GRANULAR_SWEEPS
     )
     assert solution.fc3d_error <= 1e-8
+    assert solution.u[::3].min() >= -1e-8 * np.linalg.norm(q)
     assert_de_saxce(W, q, mu, solution.r, 1e-6)
     asymmetry = abs(W - W.T).max() / abs(W).max()
     assert solution.diagnostics["W_asymmetry"] == pytest.approx(asymmetry)
@@ -310,7 +316,7 @@ def test_a_global_file_held_sparse_gives_the_dense_answer(monkeypatch):
 @pytest.mark.parametrize("method", ["nsgs", "fixed_point"])
 def test_an_asymmetric_w_is_solved_as_given_and_its_asymmetry_reported(tmp_path, method):
     """A local file whose W is not symmetric is solved on the file's own W to an FC3D error of
-    1e-10 (Siconos' fc3d_compute_error: 2-norm of the natural map over max(|q|, |r|, |u|)):
+    1e-10 (the natural map in units of velocity and the approaches, over max(|q|, |u|)):
     NSGS sweeps W as given, the fixed point's cone QPs take W's symmetric part and iterate the
     rest with the friction term. The diagnostics give the asymmetry; Anitescu's relaxation,
     one convex problem, refuses it by name. On the command line the JSON carries both."""
@@ -451,3 +457,55 @@ def test_siconos_reads_and_solves_what_lawbench_writes(tmp_path, case):
     assert sn.fc3d_nsgs(siconos_problem, r, u, options) == 0
     ours = lawbench.LAWS["moreau"].solve_contact(read_fclib(local)).r
     np.testing.assert_allclose(r, ours, atol=1e-8)
+
+
+def with_friction(source, path, mu):
+    """A global FCLIB file: ``source`` (a file, or a scene's problem written here) at ``mu``."""
+    if isinstance(source, Path):
+        shutil.copyfile(source, path)
+    else:
+        write_fclib(source, path, "global")
+    with h5py.File(path, "r+") as handle:
+        handle["fclib_global/vectors/mu"][...] = mu
+    return read_problem(path)
+
+
+@pytest.mark.parametrize("method", ["nsgs", "fixed_point"])
+def test_a_global_form_at_mu_1e6_is_solved_to_tol_on_its_own_data(tmp_path, method):
+    """LMGC90's four contacts at mu = 1e6, solved to tol = 1e-6: on the file's own M, H, f
+    and w (read here with h5py), no contact approaches by more than tol of |q|, and the natural
+    map with each impulse in velocities (``W_jj r_j``) is at most tol of the velocities. The
+    sweeps stopped at a natural map relative to impulses of 1e4, which in velocities was
+    2.2e-5 on the file's data, 22 times the tolerance."""
+    path = next(p for p in FIELD if p.stem.startswith("LMGC_GFC3D-i00501"))
+    read = with_friction(path, tmp_path / "stiff.hdf5", 1e6)
+    outcome = lawbench.LAWS["moreau"].resolve(read.problem, method=method, tol=1e-6)
+    with h5py.File(tmp_path / "stiff.hdf5", "r") as handle:
+        root = handle["fclib_global"]
+        M, H = triplets(root["M"]).toarray(), triplets(root["H"]).toarray()
+        f, w = (np.asarray(root["vectors"][k][()], dtype=float).ravel() for k in "fw")
+    r = np.column_stack([outcome.Pn, outcome.Pt.reshape(-1, 2)]).ravel()
+    u = H.T @ np.linalg.solve(M, H @ r + f) + w
+    W, q = H.T @ np.linalg.solve(M, H), H.T @ np.linalg.solve(M, f) + w
+    scale = max(np.linalg.norm(q), np.linalg.norm(u))
+    assert u[::3].min() >= -1e-6 * scale
+    residual = []
+    for j in range(4):
+        uj, zj = u[3 * j : 3 * j + 3], W[3 * j, 3 * j] * r[3 * j : 3 * j + 3]
+        shifted = uj + np.array([1e6 * np.linalg.norm(uj[1:]), 0.0, 0.0])
+        residual.append(zj - coulomb_projection(zj - shifted, 1e6))
+    assert np.linalg.norm(residual) <= 1e-6 * scale
+    assert read.facts.diagnostics(outcome)["fc3d_error"] <= 1e-6
+
+
+def test_a_sticking_contact_at_mu_1e6_is_measured_to_rounding(tmp_path):
+    """A global form's W = H.T M^-1 H and the impact's Wc.T M^-1 Wc differ by rounding, which
+    the modified velocity multiplies by mu at a sticking contact's u_T: the pencil's exact
+    answer on its own W measured 1.05e-10 on the file's at mu = 1e6, above the default
+    tol = 1e-10. Each velocity is now given its rounding."""
+    pencil = lawbench.CASES["bouncing_pencil"].build(e=0.0)
+    sticking = dataclasses.replace(pencil, contacts=[Contact(e=0.0, mu=1e6)])
+    read = with_friction(sticking, tmp_path / "pencil.hdf5", 1e6)
+    outcome = lawbench.LAWS["moreau"].resolve(read.problem)
+    assert np.linalg.norm(outcome.Pt) > 0.1 * outcome.Pn[0]  # a tangential impulse: it sticks
+    assert read.facts.diagnostics(outcome)["fc3d_error"] <= 1e-10

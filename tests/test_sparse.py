@@ -9,7 +9,7 @@ from lawbench import Contact, ImpactProblem, InvalidProblem
 from lawbench.cases._chains import SPARSE_CONTACTS
 from lawbench.core.metric import SMALL
 from lawbench.files.problem_files import load_problem, save_problem
-from lawbench.numerics.solvers import _solve_block
+from lawbench.numerics.active_sets import _solve_block
 
 
 def random_chain(seed, sparse, banded=False):

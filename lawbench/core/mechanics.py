@@ -16,6 +16,7 @@ if TYPE_CHECKING:
 # Rows beyond which a CSR product beats a dense one on a banded matrix: below, the sparse
 # product's dispatch costs more than the arithmetic it saves.
 SPARSE_PRODUCTS = 200
+EPS = float(np.finfo(float).eps)
 
 
 def separating_contacts(problem: ImpactProblem) -> list[int]:
@@ -96,27 +97,45 @@ def project_all(x: np.ndarray, mu: np.ndarray) -> np.ndarray:
 
 
 def fc3d_error(W: np.ndarray, q: np.ndarray, mu: np.ndarray, r: np.ndarray) -> float:
-    """The FC3D error of a local frictional contact answer ``r`` (Acary, Brémond, Huber 2018).
+    """The FC3D error of a local frictional contact answer ``r``, free of the problem's units.
 
     ``W``, ``q`` and ``r`` in FCLIB's local order (per contact: normal, then its tangents);
-    ``u = W r + q``. The natural map of De Saxce's complementarity, per contact
-    ``r_j - P_K(r_j - (u_j + (mu_j |u_Tj|, 0...)))``, in 2-norm over every contact, relative to
-    the largest of ``|q|``, ``|r|`` and ``|u|`` (Siconos' ``fc3d_compute_error``). Every norm
-    is taken with its entries scaled by the largest first, so that impulses of 1e300 (against
-    a ``W`` of 1e-300) overflow none. Zero exactly at a solution; ``inf`` when ``r``, ``u`` or
-    the modified velocity holds a number that is not finite: no tolerance accepts that answer.
+    ``u = W r + q``. The natural map of De Saxce's complementarity (Acary, Brémond and Huber
+    2018), per contact ``z_j - P_K(z_j - uhat_j)`` with ``uhat_j = u_j + (mu_j |u_Tj|, 0...)``
+    and the impulse taken in units of velocity, ``z_j = W_jj r_j`` (``W_jj`` the contact's
+    normal diagonal entry: the natural map's step ``1 / W_jj``, where Siconos'
+    ``fc3d_compute_error`` takes 1), joined by every approach ``min(u_Nj, 0)``; in 2-norm over
+    every contact, relative to the larger of ``|q|`` and ``|u|``. Every term is a velocity, so
+    the measure is the same in any unit of impulse (``W / s``, ``r * s``) and of velocity
+    (``W * s``, ``q * s``), contact by contact: impulses of 1e100 cannot dilute it. The
+    approaches are counted apart because the natural map sees one only through the dual cone
+    ``mu |w_T| <= w_N``, whose aperture shrinks as ``1 / mu``: at ``mu = 1e6`` a contact
+    approaching at 1 moves ``uhat`` by 1e-6 from it. A local velocity is known to its rounding,
+    ``dim eps (|W| |r| + |q|)`` row by row, and is given it: the modified velocity multiplies
+    the rounding of a sticking contact's ``|u_T|`` by ``mu``, which at ``mu = 1e6`` made an
+    error of 1e-10 of two roundings of one ``W`` (a global form's ``H.T M^-1 H`` and the
+    impact's ``Wc.T M^-1 Wc``), below which no solver's tolerance could be met. Zero exactly
+    at a solution; ``inf`` when ``r``, ``u``, the modified velocity or the rounding holds a
+    number that is not finite: no tolerance accepts that answer. Norms are taken with their
+    entries scaled by the largest first, so that none overflows.
     """
     with np.errstate(over="ignore", invalid="ignore"):
         u = W @ r + q
         dim = r.size // len(mu)
-        rj = r.reshape(-1, dim)
-        x = rj - u.reshape(-1, dim)
-        x[:, 0] -= mu * _norms(u.reshape(-1, dim)[:, 1:])
-    if not (np.isfinite(x).all() and np.isfinite(rj).all()):
+        uj = u.reshape(-1, dim)
+        rounding = (dim * EPS * (abs(W) @ np.abs(r) + np.abs(q))).reshape(-1, dim)
+        z = np.asarray(W.diagonal())[::dim, None] * r.reshape(-1, dim)
+        x = z - uj
+        x[:, 0] -= mu * np.maximum(_norms(uj[:, 1:]) - _norms(rounding[:, 1:]), 0.0)
+    if not (np.isfinite(x).all() and np.isfinite(z).all() and np.isfinite(rounding).all()):
         return math.inf
-    error = _norm((rj - project_all(x, mu)).ravel())
-    scale = max(_norm(np.asarray(q, dtype=float)), _norm(r), _norm(u))
-    return error / scale if scale > np.finfo(float).eps else error
+    with np.errstate(over="ignore"):  # mu * mu of mu near 1e300: the projection is then 0
+        projected = project_all(x, mu)
+    approach = np.minimum(uj[:, 0] + rounding[:, 0], 0.0)
+    residual = np.concatenate([(z - projected).ravel(), approach])
+    error = _norm(residual)
+    scale = max(_norm(np.asarray(q, dtype=float)), _norm(u))
+    return error / scale if scale > 0.0 else error
 
 
 def _norm(x: np.ndarray) -> float:

@@ -19,7 +19,6 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-import warnings
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -28,25 +27,16 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 import scipy.sparse
-import scipy.sparse.linalg
 
 from lawbench.core.budget import current_budget
 from lawbench.core.errors import SolverFailure
-from lawbench.core.metric import SPARSE_SHARE, as_array, is_diagonal, is_sparse
+from lawbench.core.metric import as_array, is_diagonal, is_sparse
+from lawbench.numerics.active_sets import CANCELLING, EPS, ROUNDING, polish
 
-ROUNDING = 1e-12
 # Contacts up to which active-set enumeration (2**m sets) is the exact, cheap method.
 ENUMERATION_MAX = 6
-# Blocks larger than this with at most SPARSE_SHARE non-zero entries are solved as sparse.
-SPARSE_SIZE = 64
 # Relative violation of z >= 0 and w >= 0 accepted as rounding.
 COMPLEMENTARITY = 1e-10
-# Largest rounding of the slacks w = G z + q, eps max_i sum_j |G_ij z_j|, over the velocities
-# max |q|, of an active set's solution: beyond it the slacks are rounding, not velocities. An
-# LCP without a solution (opposite normals, one contact restituted) has on a near-singular set
-# impulses of 1e16 whose slacks cancel to anything, and the set passed for its solution.
-CANCELLING = 1e-5
-EPS = float(np.finfo(float).eps)
 # clarabel's certificates that a QP has no solution: for an LCP's QP, that the LCP has none.
 NO_SOLUTION = frozenset({"PrimalInfeasible", "DualInfeasible"})
 
@@ -73,9 +63,14 @@ def clarabel_settings(tol: float, max_iter: int) -> clarabel.DefaultSettings:
 
 
 def clarabel_qp(
-    P: np.ndarray, c: np.ndarray, A: np.ndarray, tol: float, max_iter: int = 200
+    P: np.ndarray,
+    c: np.ndarray,
+    A: np.ndarray,
+    tol: float,
+    max_iter: int = 200,
+    b: np.ndarray | None = None,
 ) -> QPResult:
-    """Solve ``min x.P x / 2 + c.x`` subject to ``A x >= 0`` with clarabel.
+    """Solve ``min x.P x / 2 + c.x`` subject to ``A x >= b`` (``b = 0`` by default) with clarabel.
 
     ``P`` and ``A`` are numpy or scipy.sparse arrays; sparse ones reach clarabel as they are.
     Returns whatever clarabel ended with; the caller decides whether its status will do.
@@ -88,7 +83,7 @@ def clarabel_qp(
         upper,
         np.asarray(c, dtype=float),
         constraints,
-        np.zeros(A.shape[0]),
+        np.zeros(A.shape[0]) if b is None else -np.asarray(b, dtype=float),
         [clarabel.NonnegativeConeT(A.shape[0])],
         clarabel_settings(tol, max_iter),
     )
@@ -107,93 +102,6 @@ class LCPResult(NamedTuple):
     solver_status: str | None = None
     iterations: int = 0
     polished: bool = False
-
-
-def polish(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> np.ndarray | None:
-    """Solve the active set of an approximate LCP solution exactly.
-
-    Candidate active sets: where ``z`` exceeds the slack ``w``, then where ``z`` is not
-    negligible against its largest entry (badly scaled problems, masses over many decades,
-    leave both ``z`` and ``w`` small). Returns the exact solution on the first set that is
-    complementary to rounding, else None.
-    """
-    w = G @ z + q
-    for active in (z > w, z > 1e-6 * z.max()):
-        exact = _on_active_set(G, q, active)
-        if exact is not None:
-            return exact
-    return None
-
-
-def _on_active_set(G: np.ndarray, q: np.ndarray, active: np.ndarray) -> np.ndarray | None:
-    exact = np.zeros_like(q)
-    if active.any():
-        rows = np.flatnonzero(active)
-        block = G if rows.size == len(q) else G[np.ix_(rows, rows)]
-        try:
-            exact[active] = _solve_block(block, -q[active])
-        except (np.linalg.LinAlgError, ValueError):
-            return None
-    slack = G @ exact + q
-    velocity_scale = max(np.abs(q).max(), ROUNDING)
-    impulse_scale = max(np.abs(exact).max(), ROUNDING)
-    # A slack is a sum of terms G_ij z_j that cancel down to the size of q: their rounding too,
-    # unless it is all the slack holds (`CANCELLING`).
-    reach = abs(G) @ np.abs(exact)
-    rounding = ROUNDING * reach
-    if exact.min() < -1e-10 * impulse_scale or (slack < -1e-10 * velocity_scale - rounding).any():
-        return None
-    if EPS * float(reach.max()) > CANCELLING * velocity_scale:
-        return None
-    return np.maximum(exact, 0.0)
-
-
-def _solve_block(block: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Solve a symmetric positive (semi)definite block of a Delassus matrix.
-
-    When it is sparse, or large with few non-zero entries: by banded Cholesky when its band
-    holds no more entries than its non-zero ones (chains: each contact shares a body with its
-    neighbours only, so the block is tridiagonal), else, or when it is only semidefinite, by
-    sparse LU. A dense solve otherwise.
-
-    An ill-conditioned block (redundant contacts) is fine: the caller checks the answer.
-    """
-    if is_sparse(block) or (
-        block.shape[0] > SPARSE_SIZE and np.count_nonzero(block) <= SPARSE_SHARE * block.size
-    ):
-        band = _lower_band(block)
-        if band is not None:
-            try:
-                return scipy.linalg.solveh_banded(band, rhs, lower=True)
-            except np.linalg.LinAlgError:  # not positive definite: sparse LU decides
-                pass
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", scipy.sparse.linalg.MatrixRankWarning)
-            solution = scipy.sparse.linalg.spsolve(scipy.sparse.csc_matrix(block), rhs)
-        if not np.isfinite(solution).all():
-            raise np.linalg.LinAlgError("singular block")
-        return solution
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
-        return scipy.linalg.solve(block, rhs, assume_a="pos")
-
-
-def _lower_band(block: np.ndarray) -> np.ndarray | None:
-    """The lower band of a symmetric block in LAPACK's storage (``band[i - j, j] = block[i, j]``).
-
-    None when the band would hold more entries than the block's non-zero ones: the block is not
-    banded, and its band is no cheaper than a sparse factor.
-    """
-    entries = scipy.sparse.coo_array(block)
-    offset = entries.row - entries.col
-    width = int(offset.max(initial=0))
-    if (width + 1) * block.shape[0] > entries.nnz:
-        return None
-    lower = offset >= 0
-    band = np.zeros((width + 1, block.shape[0]))
-    # Added, not assigned: a sparse block may list an entry in several parts.
-    np.add.at(band, (offset[lower], entries.col[lower]), entries.data[lower])
-    return band
 
 
 @functools.cache
@@ -452,8 +360,12 @@ def _lcp_violation(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     """How far ``z >= 0`` is from solving ``0 <= G z + q _|_ z``, over the LCP's own scales.
 
     The larger of a negative slack ``w = G z + q`` and a slack left open where ``z`` pushes,
-    over the contact velocities ``max |q|`` (and the impulses ``max z``); the rounding of the
-    slacks, sums of terms ``G_ij z_j`` that cancel, is allowed, unless it is all they hold
+    over the contact velocities ``max |q|``. An open slack counts up to the velocity its own
+    impulse gives its contact, ``G_jj z_j``: the complementarity ``z_j w_j = 0`` in units of
+    velocity, contact by contact, so that an impulse of 0.5 on a ball of mass 1 is not
+    dwarfed by impulses of 1e9 on its neighbours of mass 1e9 (an impulse scaled by the
+    largest one let a light ball leave its chain with a slack of 0.08 open). The rounding of
+    the slacks, sums of terms ``G_ij z_j`` that cancel, is allowed, unless it is all they hold
     (infinite then).
     """
     w = G @ z + q
@@ -462,9 +374,8 @@ def _lcp_violation(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     velocity = max(float(np.abs(q).max(initial=0.0)), ROUNDING)
     if EPS * float(reach.max(initial=0.0)) > CANCELLING * velocity:
         return math.inf  # the slacks are the rounding of impulses that cancel (`CANCELLING`)
-    impulse = max(float(z.max(initial=0.0)), ROUNDING)
     below = float(np.max(-(w + rounding), initial=0.0)) / velocity
-    opened = np.maximum(w - rounding, 0.0) * z / impulse
+    opened = np.minimum(np.maximum(w - rounding, 0.0), np.asarray(G.diagonal()) * z)
     return max(below, float(opened.max(initial=0.0)) / velocity)
 
 
@@ -498,8 +409,39 @@ def project_on_cone(
     return _finish(G, Wn.T @ v, result.y, result, refine, tol)
 
 
+def project_in_kinetic_metric(
+    M: np.ndarray,
+    v: np.ndarray,
+    Wn: np.ndarray,
+    G: np.ndarray,
+    q: np.ndarray,
+    tol: float,
+    refine: bool,
+) -> LCPResult:
+    """Solve an impact's LCP ``0 <= G z + q _|_ z >= 0`` as a projection where ``M`` is ``I``.
+
+    ``G = Wn.T M^-1 Wn`` and ``q = Wn.T v + b``. With ``M = L L.T`` and ``y = L.T w``, Moreau's
+    projection ``min |y - L.T v|^2 / 2`` over ``(L^-1 Wn).T y >= -b`` has the impulses as its
+    multipliers (``w = v + M^-1 Wn z``, ``Wn.T w + b = G z + q``). The QP in the impulses has
+    the condition of ``G``, that of ``M`` where the contacts move bodies of very different
+    masses (impulses of 1e9 on bodies of 1e9 beside ones of 1 on bodies of 1): clarabel ended
+    it 'AlmostSolved' with impulses of 1e-26, the bodies untouched. Here the Hessian is the
+    identity, and the constraints have the condition of ``G``'s square root.
+    """
+    L = np.linalg.cholesky(as_array(M))
+    A = scipy.linalg.solve_triangular(L, as_array(Wn), lower=True)
+    result = clarabel_qp(np.eye(len(v)), -(L.T @ v), A.T, tol, b=Wn.T @ v - q)
+    return _finish(G, q, result.y, result, refine, tol, "projection in the kinetic metric")
+
+
 def _finish(
-    G: np.ndarray, q: np.ndarray, z: np.ndarray, result: QPResult, refine: bool, tol: float
+    G: np.ndarray,
+    q: np.ndarray,
+    z: np.ndarray,
+    result: QPResult,
+    refine: bool,
+    tol: float,
+    form: str = "LCP",
 ) -> LCPResult:
     """Polish clarabel's answer; a status other than 'Solved' is accepted only when polished.
 
@@ -539,5 +481,5 @@ def _finish(
                 "or the LCP has no solution"
             )
     return LCPResult(
-        z, G @ z + q, "LCP (clarabel)", result.status, result.iterations, exact is not None
+        z, G @ z + q, f"{form} (clarabel)", result.status, result.iterations, exact is not None
     )

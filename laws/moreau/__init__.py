@@ -44,7 +44,12 @@ solved exactly by active-set enumeration up to ``ENUMERATION_MAX`` contacts
 (`lawbench.numerics.solvers.enumerate_lcp`; for one coefficient its solution is ``(1 + e)`` times
 the plastic projection's), and beyond that the cone projection (a QP in the velocities, solved with
 clarabel) for one coefficient when no closed contact separates, or the LCP in the impulses (a QP in
-``Pn >= 0``, solved with clarabel) otherwise. With friction, the second-order cone QP in the
+``Pn >= 0``, solved with clarabel) otherwise; where clarabel fails on that LCP, the same law as a
+projection in the coordinates where the kinetic metric is the identity ("projection in the kinetic
+metric (clarabel)", `lawbench.numerics.solvers.project_in_kinetic_metric`). Each clarabel answer is
+polished on its active set, found by principal pivoting where clarabel's does not hold
+(`lawbench.numerics.active_sets`): bodies of masses 1e9 and 1 leave an interior point's answer
+right on the heavy bodies only. With friction, the second-order cone QP in the
 impulses ``min P.G P / 2 + (q + s).P`` over the cones ``K_j`` (``G`` the contact Delassus matrix,
 ``q = u- + (E r, 0)``, ``s`` on the normal components), solved with clarabel
 (`lawbench.numerics.cones`). A sparse problem (`ImpactProblem.sparse`, long chains) stays sparse on
@@ -127,7 +132,7 @@ import numpy as np
 from lawbench.checks.regions import option, separating_contact
 from lawbench.core.budget import current_budget
 from lawbench.core.contact import ContactProblem
-from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
 from lawbench.core.law import LAWS, Law
 from lawbench.core.metric import as_array
 from lawbench.core.outcome import Outcome
@@ -144,6 +149,7 @@ from lawbench.laws._claims import (
     separating_held,
 )
 from lawbench.laws.moreau.answers import refuse_cancelling, refuse_outside_cones
+from lawbench.laws.moreau.frictionless import lcp, projected
 from lawbench.laws.moreau.methods import (
     FIXED_POINT_MAX,
     FIXED_POINT_STEPS,
@@ -162,13 +168,7 @@ from lawbench.numerics.gauss_seidel import (
     one_contact,
     solve_polished,
 )
-from lawbench.numerics.solvers import (
-    ENUMERATION_MAX,
-    LCPResult,
-    enumerate_lcp,
-    project_on_cone,
-    solve_lcp,
-)
+from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp
 
 if TYPE_CHECKING:
     from lawbench.core.batch import ProblemBatch
@@ -297,18 +297,12 @@ class Moreau(Law):
             return _resolve_friction(problem, e * restituted, options)
         large = problem.m > ENUMERATION_MAX
         single_e = large and (e == e[0]).all() and np.array_equal(restituted, un)
-        plastic = _projected(problem, options) if single_e and not problem.decoupled else None
+        plastic = projected(problem, options) if single_e and not problem.decoupled else None
         if plastic is not None:
             result, Pn = plastic, (1.0 + e[0]) * plastic.z
             formulation = "cone projection (clarabel)"
         else:
-            result = solve_lcp(
-                problem.delassus,
-                un + e * restituted,
-                options["tol"],
-                options["polish"],
-                decoupled=problem.decoupled,
-            )
+            result = lcp(problem, un + e * restituted, options)
             Pn, formulation = result.z, result.method
         diagnostics = {
             "formulation": formulation,
@@ -367,30 +361,6 @@ class Moreau(Law):
         return Pn, "LCP (active-set enumeration, batch)"
 
 
-def _projected(problem: ImpactProblem, options: dict[str, Any]) -> LCPResult | None:
-    """The plastic impact as a projection on the cone of admissible velocities, or None.
-
-    None where clarabel's velocity QP fails for want of precision: a mass matrix with a stiff
-    coordinate the contacts do not move (condition 1e9 and more) leaves its multipliers off by
-    the contacts' own velocities, and the LCP on the Delassus matrix, which holds the contacts'
-    coordinates only, is the well-conditioned form of the same law (an LCP without a solution
-    fails there too, saying so). A spent budget stops the solve.
-    """
-    try:
-        return project_on_cone(
-            problem.M,
-            problem.v,
-            problem.Wn,
-            problem.delassus,
-            options["tol"],
-            options["polish"],
-        )
-    except BudgetExceeded:
-        raise
-    except SolverFailure:
-        return None
-
-
 UNDAMPED = 20
 # Relative tolerance of Coulomb's conditions on a mode's closed form at one contact.
 COULOMB_TOLERANCE = 1e-9
@@ -437,14 +407,13 @@ def _approaching(u: np.ndarray, m: int, tol: float, scale: float) -> bool:
 def _leaving(problem: ContactProblem, r: np.ndarray, tol: float) -> np.ndarray:
     """``r`` when no contact approaches after it (`_approaching`), else the exact state.
 
-    The FC3D error cannot see an approaching contact whose ``un`` the modified velocity lost
-    to rounding (``mu`` near 1e300), nor one of an answer grown far beyond ``q`` on a ``W``
-    that is not positive definite: the normal law is checked on ``u`` itself.
+    Each method stops at its own test; the normal law is checked here on ``u`` itself, against
+    velocities only, so that no size of impulses (``W`` of 1e-100, impulses of 1e100) and no
+    ``mu`` near 1e300 (whose modified velocity loses ``un`` to rounding) hides an approach.
     """
     u = problem.velocity(r)
-    # The scale the FC3D error is normalized by (Siconos' max of |q|, |r| and |u|): an answer
-    # within its tolerance may leave un that far below zero, in the measure's mixed units.
-    scale = max(float(np.abs(problem.q).max()), float(np.abs(r).max()), float(np.abs(u).max()))
+    # Velocities only: impulses, in other units, would make any approach look small.
+    scale = max(float(np.abs(problem.q).max()), float(np.abs(u).max()))
     if not _approaching(u[:: problem.dim], problem.m, tol, scale):
         return r
     return _one_contact_or_refuse(problem.W.toarray(), problem.q, problem.mu)
