@@ -569,6 +569,14 @@ def test_unknown_or_empty_names_and_paths_are_refused(tmp_path, capsys, monkeypa
     assert not any(tmp_path.iterdir())
 
 
+def test_a_check_with_nothing_to_check_is_refused(capsys):
+    """A check on scenes the law does not treat, with no random problem, checks nothing: it
+    is refused (exit 3), never a pass."""
+    assert cli.main(["check", "brach", "--cases", "three_ball_chain", "--random", "0"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nothing to check" in err[0], err
+
+
 def test_the_python_api_refuses_unknown_names_too():
     """regress and check_law name what they do not know rather than return an empty result."""
     from lawbench.studies.baselines import regress

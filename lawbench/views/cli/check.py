@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from lawbench.core.case import CASES
-from lawbench.core.errors import InvalidProblem
+from lawbench.core.errors import InvalidProblem, NotApplicable
 from lawbench.core.law import LAWS, Law
 from lawbench.views.cli.main import MAX_REPEATS, CheckFailed, _count, _names
 
@@ -43,6 +43,12 @@ def run(args: argparse.Namespace) -> None:
     cases = _names(args.cases, "--cases", CASES)
     report = check_law(_law_object(args.law), cases=cases, random_problems=args.random)
     frame = report.to_frame()
+    if frame.empty:
+        given = f"the scenes {', '.join(cases)}" if cases else "every scene"
+        raise NotApplicable(
+            f"{report.law}: treats none of {given}, and no random problem was asked for: "
+            "nothing to check"
+        )
     if args.json:
         print(frame.to_json(orient="records", indent=1))
     else:
