@@ -225,6 +225,20 @@ def test_mujoco_tuned_friction_feeds_the_normal_spring_where_the_rows_are_couple
     assert frictionless.v_plus[0] == pytest.approx(0.9, abs=1e-3)
 
 
+def test_mujoco_defaults_read_the_momentum_the_solver_applied_on_a_grazing_approach():
+    """Two balls and a wall approaching at 1e-5 m/s: MuJoCo's solver stops at its tolerance
+    with the acceleration it integrates off its reported forces by up to the force itself;
+    read from what the step applied, the outcome is MuJoCo's own velocity (measured 7e-17 in
+    the kinetic metric, relative; the reported forces alone, 1.9e-2, and the first contact left
+    approaching at -9.4e-8 m/s where MuJoCo separates it at +2.7e-7)."""
+    from lawbench.core.trial import make_trial
+
+    trial = make_trial("mujoco", "two_balls_wall", params={"e": [0.0]}, transform="grazing=1e-05")
+    assert trial.outcome.diagnostics["engine_velocity_gap"] < 1e-9
+    assert (trial.problem.Wn.T @ trial.outcome.v_plus)[0] == pytest.approx(2.7e-7, abs=1e-8)
+    assert str(lawbench.run_checks(trial, checks=["admissible"])["admissible"].verdict) == "holds"
+
+
 @pytest.mark.parametrize(("engine", "speed"), [("mujoco", 1e-10), ("drake", 1e-8)])
 def test_an_engine_gives_back_the_starting_overlap_s_energy_on_a_grazing_approach(engine, speed):
     """The finding's witnesses: the lamina approaching slower than its starting overlap (1.1e-10

@@ -13,13 +13,14 @@ their reference acceleration is ``-b v``, the normal direction's damping (or sol
 Conventions: the common stepping rule of the engine laws (`lawbench.laws.engines._base`), with
 MuJoCo's semi-implicit Euler step; a step's contact force is the one mj_contactForce gives at
 its start (contact frame: the normal from the contact's first geom to its second, then two
-tangents), acting on the second geom's body, and the step's velocity change is the step times
-the accelerations that force gives. Every geom collides only through the scene's declared pairs
-(contype and conaffinity 0, one explicit pair per two bodies), with no margin: a contact is
-active once the bodies overlap. Bodies: the body frame at the centre of mass with the given
-mass and principal inertia (inertial element); free joints (freejoint), planar joints (two
-slides in the plane and a hinge about its normal), hinges and slides; fixed bodies are geoms of
-the world body. Gravity is off.
+tangents), acting on the second geom's body, once the constraint forces are made those of the
+acceleration the step integrated (its velocity change over the step): MuJoCo's solver stops at
+its tolerance (XML reference, option: tolerance) with the two apart at small forces. Every
+geom collides only through the scene's declared pairs (contype and conaffinity 0, one explicit
+pair per two bodies), with no margin: a contact is active once the bodies overlap. Bodies: the
+body frame at the centre of mass with the given mass and principal inertia (inertial element);
+free joints (freejoint), planar joints (two slides in the plane and a hinge about its normal),
+hinges and slides; fixed bodies are geoms of the world body. Gravity is off.
 
 Settings (option ``settings``):
 
@@ -371,9 +372,16 @@ class _MuJoCoScene(Scene):
                     address += 1
 
     def step(self) -> tuple[list[Force], np.ndarray]:
-        """One mj_step: the forces of its contacts, and the bodies' velocities."""
+        """One mj_step: the forces of its contacts, and the bodies' velocities.
+
+        The velocities are mj_objectVelocity's, from the body velocities (cvel) mj_step computed
+        before integrating: those the step started from. The stepping rule keeps them once
+        steps without force have passed (`lawbench.laws.engines._base.QUIET_STEPS`), where they
+        are the same.
+        """
         mujoco, model, data = self.mujoco, self.model, self.data
         mujoco.mj_step(model, data)
+        self._balance()
         forces = []
         for i in range(data.ncon):
             contact = data.contact[i]
@@ -389,6 +397,34 @@ class _MuJoCoScene(Scene):
                 )
                 velocities[k] = np.concatenate([self.velocity[3:], self.velocity[:3]])
         return forces, velocities
+
+    def _balance(self) -> None:
+        """Make the step's constraint forces those that give the acceleration MuJoCo integrated.
+
+        MuJoCo's solver stops once an iteration improves its cost by less than its tolerance
+        (option tolerance, 1e-8 by default): at small forces (a grazing approach, the tail of a
+        soft contact) it stops after one iteration where the constraint force it reports,
+        ``J^T efc_force``, falls short of ``M qacc - qfrc_smooth`` by up to the force itself,
+        and the bodies move by qacc. The least-norm correction of the constraint forces that
+        closes that residual is added to efc_force (and qfrc_constraint), so that the contact
+        forces read from them (mj_contactForce) carry the momentum the step applied.
+        """
+        mujoco, model, data = self.mujoco, self.model, self.data
+        if not data.nefc:
+            return
+        residual = np.zeros(model.nv)
+        mujoco.mj_mulM(model, data, residual, data.qacc)
+        residual -= data.qfrc_smooth + data.qfrc_constraint
+        if mujoco.mj_isSparse(model):
+            J = np.zeros((data.nefc, model.nv))
+            mujoco.mju_sparse2dense(
+                J, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr, data.efc_J_colind
+            )
+        else:
+            J = data.efc_J.reshape(data.nefc, model.nv)
+        correction = np.linalg.lstsq(J.T, residual, rcond=None)[0]
+        data.efc_force[:] += correction
+        data.qfrc_constraint[:] += J.T @ correction
 
     def distances(self) -> np.ndarray:
         """mj_geomDistance of each pair's geoms, at the positions the last step started from.
