@@ -239,6 +239,22 @@ def test_mujoco_defaults_read_the_momentum_the_solver_applied_on_a_grazing_appro
     assert str(lawbench.run_checks(trial, checks=["admissible"])["admissible"].verdict) == "holds"
 
 
+def test_mujoco_defaults_leave_a_turning_block_s_pivot_approaching_along_its_frozen_normal():
+    """The finding's witness: the rocking block of width and height 1 m landing with e = 0 turns
+    in MuJoCo's 56 ms impact; the forces at the frozen arms leave its pivot approaching at
+    -2.2e-3 m/s where MuJoCo's own velocity separates it at +4.5e-4, a law property."""
+    from lawbench.core.trial import make_trial
+
+    params = {"width": 1.0, "height": 1.0, "e": 0.0, "mu": 0.0}
+    trial = make_trial("mujoco", "rocking_block", params=params)
+    engine = np.asarray(trial.outcome.diagnostics["engine_v_plus"])
+    assert (trial.problem.Wn.T @ trial.outcome.v_plus)[1] == pytest.approx(-2.2e-3, abs=1e-4)
+    assert (trial.problem.Wn.T @ engine)[1] == pytest.approx(4.5e-4, abs=1e-5)
+    result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
+    assert str(result.verdict) == "law property"
+    assert result.claim.region.text.endswith(_regions.turning_impact.text)
+
+
 @pytest.mark.parametrize(("engine", "speed"), [("mujoco", 1e-10), ("drake", 1e-8)])
 def test_an_engine_gives_back_the_starting_overlap_s_energy_on_a_grazing_approach(engine, speed):
     """The finding's witnesses: the lamina approaching slower than its starting overlap (1.1e-10
