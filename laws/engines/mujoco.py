@@ -97,6 +97,8 @@ STEPS_PER_CONTACT = 200
 IMPEDANCE = 0.9999
 # The least damping of the friction of a tuned contact, over sqrt(k): critical damping.
 FRICTION_DAMPING = 2.0
+# A solver's residual below this fraction of the step's constraint force is rounding: not read.
+ROUNDING = 1e-12
 
 
 @functools.cache
@@ -428,6 +430,8 @@ class _MuJoCoScene(Scene):
         residual = np.zeros(model.nv)
         mujoco.mj_mulM(model, data, residual, data.qacc)
         residual -= data.qfrc_smooth + data.qfrc_constraint
+        if np.abs(residual).max() <= ROUNDING * np.abs(data.qfrc_constraint).max():
+            return
         if mujoco.mj_isSparse(model):
             J = np.zeros((data.nefc, model.nv))
             mujoco.mju_sparse2dense(
