@@ -62,6 +62,7 @@ import math
 from types import ModuleType
 
 import numpy as np
+import scipy.optimize
 
 from lawbench.checks.regions import coupled_friction, oblique_contacts, option
 from lawbench.core.errors import NotApplicable
@@ -420,9 +421,10 @@ class _MuJoCoScene(Scene):
         (option tolerance, 1e-8 by default): at small forces (a grazing approach, the tail of a
         soft contact) it stops after one iteration where the constraint force it reports,
         ``J^T efc_force``, falls short of ``M qacc - qfrc_smooth`` by up to the force itself,
-        and the bodies move by qacc. The least-norm correction of the constraint forces that
-        closes that residual is added to efc_force (and qfrc_constraint), so that the contact
-        forces read from them (mj_contactForce) carry the momentum the step applied.
+        and the bodies move by qacc. The correction of the constraint forces that closes that
+        residual in least squares, each row that cannot pull (`_pushing`) kept from pulling, is
+        added to efc_force (and qfrc_constraint), so that the contact forces read from them
+        (mj_contactForce) carry the momentum the step applied, within the cone.
         """
         mujoco, model, data = self.mujoco, self.model, self.data
         if not data.nefc:
@@ -439,9 +441,23 @@ class _MuJoCoScene(Scene):
             )
         else:
             J = data.efc_J.reshape(data.nefc, model.nv)
-        correction = np.linalg.lstsq(J.T, residual, rcond=None)[0]
+        lower = np.where(self._pushing(), -data.efc_force, -np.inf)
+        bounds = (lower, np.full(data.nefc, np.inf))
+        correction = scipy.optimize.lsq_linear(J.T, residual, bounds, method="bvls").x
         data.efc_force[:] += correction
         data.qfrc_constraint[:] += J.T @ correction
+
+    def _pushing(self) -> np.ndarray:
+        """Which constraint rows push only.
+
+        Every row of a frictionless or pyramidal contact (the normal, or an edge of the
+        pyramid), and the first (normal) row of an elliptic one.
+        """
+        data, kinds = self.data, self.mujoco.mjtConstraint
+        pushing = data.efc_type != kinds.mjCNSTR_CONTACT_ELLIPTIC
+        for contact in data.contact[: data.ncon]:
+            pushing[contact.efc_address] = True
+        return pushing
 
     def distances(self) -> np.ndarray:
         """mj_geomDistance of each pair's geoms, at the positions the last step started from.
