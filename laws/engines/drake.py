@@ -34,14 +34,14 @@ Settings (option ``settings``):
   discrete update, they report the forces of that update. e has no effect: struck at v0, a
   contact of dissipation d leaves at about ``1 / (d v0)``, with Drake's d = 50 s/m 0.010 of
   the approach at 2 m/s and 0.005 at 3.9 m/s (measured on the sphere striking a wall head-on,
-  for any e). The elastic three-ball chain
-  ends at (0.314, 0.334, 0.353), a third of its energy (Moreau's (-1/3, 2/3, 2/3)). Point
-  contact gives a box lying flat on a plane one contact point (the rocking block's landing
-  finds one point on its face, and its force maps to one corner: v+ (-0.370, 0.202, 0.542)
-  where Moreau's law gives (-0.350, 0.175, 0.700), 10 % of its motion off the problem's
-  directions). The lagged approximation bounds a step's friction with the normal force of the
-  step before, so the impulse leaves the friction cone where the normal force falls: 2.6 mu
-  Pn on the slipping rocking block (the similar approximation keeps it within mu Pn).
+  for any e). The elastic three-ball chain ends at (0.314, 0.334, 0.353), a third of its energy
+  (Moreau's (-1/3, 2/3, 2/3)). Point contact gives a box lying flat on a plane one contact
+  point (the rocking block's landing finds one point on its face, and its force maps to one
+  corner: v+ (-0.370, 0.202, 0.542) where Moreau's law gives (-0.350, 0.175, 0.700), 10 % of
+  its motion off the problem's directions). The lagged approximation bounds a step's friction
+  with the normal force of the step before, so the impulse leaves the friction cone where the
+  normal force falls: 2.6 mu Pn on the slipping rocking block (the similar approximation keeps
+  it within mu Pn).
 - ``tuned``, as rigid and faithful to e and mu as Drake allows: continuous time (time_step 0)
   with Runge-Kutta 3 at target accuracy `ACCURACY` and steps of at most dt, point contact, one
   geometry per pair on each of its bodies (a box touching through a small sphere at the pair's
