@@ -404,6 +404,22 @@ def test_drake_defaults_report_the_forces_of_every_discrete_update_at_small_step
     assert str(lawbench.run_checks(trial, checks=["admissible"])["admissible"].verdict) == "holds"
 
 
+def test_drake_defaults_report_the_overlap_s_force_its_solver_does_not_apply():
+    """The finding's witness: the three-ball chain grazing at 1e-8 m/s, slower than its
+    starting overlap per step. Drake's own velocity separates both contacts; the impulses the
+    contact results report, which the discrete solver did not apply below its tolerance, leave
+    the second approaching at -7.4e-6 m/s, a law property of the defaults."""
+    from lawbench.core.trial import make_trial
+
+    trial = make_trial("drake", "three_ball_chain", params={"e": [0.0]}, transform="grazing=1e-08")
+    engine = np.asarray(trial.outcome.diagnostics["engine_v_plus"])
+    assert (trial.problem.Wn.T @ engine).min() > 1e-7
+    assert (trial.problem.Wn.T @ trial.outcome.v_plus)[1] == pytest.approx(-7.4e-6, abs=2e-7)
+    result = lawbench.run_checks(trial, checks=["admissible"])["admissible"]
+    assert str(result.verdict) == "law property"
+    assert result.claim.region.text.endswith(_regions.misreported_impulse.text)
+
+
 def test_drake_defaults_leave_a_contact_at_one_over_its_dissipation_times_speed():
     """Drake's default dissipation, 50 s/m: struck at 3.9 m/s the sphere leaves at 0.005 of it,
     whatever e (the relation's large-u end, e = 1 / u, measured to 1 %)."""

@@ -91,6 +91,31 @@ turning_impact = Region(
 )
 
 
+def _misreported(trial: Any) -> bool:
+    """Whether a closed contact approaches after the impact in the outcome but not in the engine.
+
+    The outcome's velocity is the pre-impact one plus the impulses of the forces the engine
+    reports; the engine's own (``engine_v_plus``) is its state after its steps. Where the second
+    leaves every closed contact at rest or separating (within `APPROACH` of the fastest
+    approach) and the first does not, the forces the engine reports are not all it applied.
+    """
+    problem, outcome = trial.problem, trial.outcome
+    engine = outcome.diagnostics.get("engine_v_plus")
+    closed = problem.closed
+    if engine is None or not closed.any():
+        return False
+    rest = APPROACH * float(-np.min(problem.un, initial=0.0))
+    own = gap_rates(problem, np.asarray(engine))[closed]
+    return bool(gap_rates(problem, outcome.v_plus)[closed].min() < 0.0 and own.min() >= -rest)
+
+
+misreported_impulse = Region(
+    "a closed contact approaches after the impact by the forces the engine reports, not by its "
+    "own velocity",
+    _misreported,
+)
+
+
 def slopped(slop: float, unsolved: float) -> Region:
     """Closed contacts left approaching within an engine's contact slop over its step.
 

@@ -106,9 +106,11 @@ from lawbench.laws.engines._base import (
 from lawbench.laws.engines._drake_scene import DrakeScene, Tuning
 from lawbench.laws.engines._regions import (
     elastic_contact,
+    misreported_impulse,
     moving_impact,
     normal_turned,
     overlap_given_back,
+    slower_than_overlap,
     turning_impact,
 )
 
@@ -343,6 +345,20 @@ class Drake(EngineLaw):
             f"{_DOCS}: DefaultProximityProperties (point_stiffness 1e6 N/m), MultibodyPlantConfig "
             "(time_step 1 ms)",
             "the billiard shot at mu = 0 takes |Pt| = 0.0035 N s",
+        ),
+        Claim(
+            "admissible",
+            option("settings", "default") & slower_than_overlap & misreported_impulse,
+            f"{_DOCS}: MultibodyPlantConfig (the lagged approximation, solved by SAP), "
+            "get_contact_results_output_port (contact results of the discrete update)",
+            "at its defaults the discrete solver stops at its tolerance on the momentum, and a "
+            "step whose contact impulse is below it changes no velocity while the contact "
+            "results report the contact's force: a grazing approach slower than the starting "
+            "overlap pushes with that overlap's force for many steps before a step applies it "
+            "(the three-ball chain grazing at 1e-8 m/s: 76 steps of 1 ms report up to 4.3e-7 N s "
+            "each and change no velocity, the reported impulses add up to 1.8e-5 N s; Drake's "
+            "own velocity separates the contacts at +2.0e-7 and +2.9e-7 m/s, the outcome leaves "
+            "the second approaching at -7.4e-6)",
         ),
         Claim(
             "admissible",
