@@ -165,7 +165,7 @@ class DrakeScene(Scene):
         self._place(poses, velocities)
         self.simulator.Initialize()
         self.points = self._material_points()
-        self.time, self.impulse = 0.0, np.zeros(3 * len(geometry.pairs))
+        self.steps, self.impulse = 0, np.zeros(3 * len(geometry.pairs))
         if self.tuned:
             self.impulse_context = self.impulses.GetMyContextFromRoot(root)
 
@@ -354,10 +354,13 @@ class DrakeScene(Scene):
         """Advance the simulator by dt: the step's contact forces, and the bodies' velocities.
 
         Tuned, each pair's force is its impulse over the step divided by dt; at the defaults,
-        the point pairs' forces the plant samples for the step (constant over it).
+        the point pairs' forces the plant samples for the step (constant over it). The k-th step
+        ends at ``k dt``, the time of the plant's k-th discrete update to the float: a sum of
+        dt's drifts from it, and an advance that stops short of an update time or passes it
+        makes no update or two, of which the sampled results report the last.
         """
-        self.time += self.dt
-        self.simulator.AdvanceTo(self.time)
+        self.steps += 1
+        self.simulator.AdvanceTo(self.steps * self.dt)
         forces = self._integrated() if self.tuned else self._sampled()
         velocities = np.zeros((len(self.bodies), 6))
         for k, rigid in enumerate(self.bodies):

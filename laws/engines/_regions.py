@@ -97,7 +97,7 @@ def _misreported(trial: Any) -> bool:
     The outcome's velocity is the pre-impact one plus the impulses of the forces the engine
     reports; the engine's own (``engine_v_plus``) is its state after its steps. Where the second
     leaves every closed contact at rest or separating (within `APPROACH` of the fastest
-    approach) and the first does not, the forces the engine reports miss part of what it applied.
+    approach) and the first does not, the forces the engine reports are not all it applied.
     """
     problem, outcome = trial.problem, trial.outcome
     engine = outcome.diagnostics.get("engine_v_plus")
