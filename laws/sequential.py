@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core.budget import current_budget
+from lawbench.core.guards import current_budget
 from lawbench.core.law import LAWS, Law
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem

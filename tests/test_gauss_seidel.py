@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.core.budget import Budget
 from lawbench.core.case import CASES
 from lawbench.core.errors import BudgetExceeded, InvalidProblem, SolverFailure
+from lawbench.core.guards import Budget
 from lawbench.files.fclib import read_fclib
 from lawbench.files.problem_files import read_problem
 from lawbench.numerics.gauss_seidel import error_of, in_local_order, solve_nsgs

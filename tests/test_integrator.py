@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import lawbench
-from lawbench.core.budget import Budget
 from lawbench.core.errors import BudgetExceeded, SolverFailure
+from lawbench.core.guards import Budget
 from lawbench.numerics.integrator import EventIntegrator
 
 

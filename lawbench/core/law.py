@@ -7,7 +7,7 @@ checks the options and the problem against the tags, restricts the problem to it
 units near it and scales the answer back (`ImpactProblem.units`), times the solve within the
 budget its options set, and refuses to return a non-finite answer.
 
-The budget is what one solve may spend (`lawbench.core.budget`): `Law.resolve` opens a `Budget`
+The budget is what one solve may spend (`lawbench.core.guards`): `Law.resolve` opens a `Budget`
 from the law's options for the time of the solve: ``max_seconds`` (every law has it),
 ``max_steps`` (a law that steps: integrator steps, fixed-point iterations, binary impacts) and
 ``max_events`` (a law that restarts at events), each when the law declares it. The law's loops
@@ -44,7 +44,6 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from lawbench.core.budget import Watch
 from lawbench.core.contact import ContactProblem, ContactSolution
 from lawbench.core.errors import (
     InvalidProblem,
@@ -53,6 +52,7 @@ from lawbench.core.errors import (
     SolverFailure,
 )
 from lawbench.core.guards import (
+    Watch,
     from_user,
     inputs,
     refuse_non_finite,

@@ -29,8 +29,8 @@ import clarabel
 import numpy as np
 import scipy.sparse
 
-from lawbench.core.budget import current_budget
 from lawbench.core.errors import SolverFailure
+from lawbench.core.guards import current_budget
 from lawbench.core.mechanics import project
 from lawbench.core.metric import binary_scale
 from lawbench.numerics.solvers import clarabel_settings

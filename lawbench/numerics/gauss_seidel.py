@@ -65,9 +65,8 @@ from typing import Any, TypeVar
 import numpy as np
 import scipy.sparse
 
-from lawbench.core.budget import current_budget
 from lawbench.core.errors import SolverFailure
-from lawbench.core.guards import held
+from lawbench.core.guards import current_budget, held
 from lawbench.core.mechanics import fc3d_error, project
 from lawbench.numerics import cones
 

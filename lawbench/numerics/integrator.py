@@ -22,8 +22,8 @@ from functools import partial
 
 import numpy as np
 
-from lawbench.core.budget import current_budget
 from lawbench.core.errors import SolverFailure
+from lawbench.core.guards import current_budget
 from lawbench.numerics.roots import crossing
 
 Field = Callable[[float, np.ndarray], np.ndarray]

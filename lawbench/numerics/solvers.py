@@ -28,8 +28,8 @@ import scipy.linalg
 import scipy.optimize
 import scipy.sparse
 
-from lawbench.core.budget import current_budget
 from lawbench.core.errors import SolverFailure
+from lawbench.core.guards import current_budget
 from lawbench.core.metric import as_array, is_diagonal, is_sparse
 from lawbench.numerics.active_sets import CANCELLING, EPS, ROUNDING, polish
 

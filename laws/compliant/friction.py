@@ -78,7 +78,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lawbench.core.budget import current_budget
+from lawbench.core.guards import current_budget
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.laws.compliant.normal import Integration

@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
-from lawbench.core.budget import current_budget
 from lawbench.core.errors import NotApplicable
+from lawbench.core.guards import current_budget
 from lawbench.core.mechanics import for_products
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem

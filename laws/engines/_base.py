@@ -36,10 +36,9 @@ from typing import Any, ClassVar
 import numpy as np
 import scipy.optimize
 
-from lawbench.core.budget import current_budget
 from lawbench.core.errors import SolverFailure
 from lawbench.core.geometry import TOLERANCE, Body, ContactPair, Geometry
-from lawbench.core.guards import held
+from lawbench.core.guards import current_budget, held
 from lawbench.core.law import Law
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem

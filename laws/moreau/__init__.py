@@ -130,9 +130,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from lawbench.checks.regions import option, separating_contact
-from lawbench.core.budget import current_budget
 from lawbench.core.contact import ContactProblem
-from lawbench.core.errors import InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, NotApplicable, SolverFailure
+from lawbench.core.guards import current_budget
 from lawbench.core.law import LAWS, Law
 from lawbench.core.metric import as_array
 from lawbench.core.outcome import Outcome
@@ -149,7 +149,7 @@ from lawbench.laws._claims import (
     separating_held,
 )
 from lawbench.laws.moreau.answers import refuse_cancelling, refuse_outside_cones
-from lawbench.laws.moreau.frictionless import lcp, projected
+from lawbench.laws.moreau.frictionless import projected
 from lawbench.laws.moreau.methods import (
     FIXED_POINT_MAX,
     FIXED_POINT_STEPS,
@@ -168,7 +168,13 @@ from lawbench.numerics.gauss_seidel import (
     one_contact,
     solve_polished,
 )
-from lawbench.numerics.solvers import ENUMERATION_MAX, enumerate_lcp
+from lawbench.numerics.solvers import (
+    ENUMERATION_MAX,
+    LCPResult,
+    enumerate_lcp,
+    project_in_kinetic_metric,
+    solve_lcp,
+)
 
 if TYPE_CHECKING:
     from lawbench.core.batch import ProblemBatch
@@ -302,7 +308,7 @@ class Moreau(Law):
             result, Pn = plastic, (1.0 + e[0]) * plastic.z
             formulation = "cone projection (clarabel)"
         else:
-            result = lcp(problem, un + e * restituted, options)
+            result = _lcp(problem, un + e * restituted, options)
             Pn, formulation = result.z, result.method
         diagnostics = {
             "formulation": formulation,
@@ -359,6 +365,32 @@ class Moreau(Law):
         if not found.all():
             return None
         return Pn, "LCP (active-set enumeration, batch)"
+
+
+def _lcp(problem: ImpactProblem, q: np.ndarray, options: dict[str, Any]) -> LCPResult:
+    """The LCP in the impulses, or where clarabel fails on it, the projection it is.
+
+    The projection in the kinetic metric (`project_in_kinetic_metric`) holds ``M``'s condition
+    in its constraints' square root, where the LCP holds all of it in its Hessian: a chain of
+    balls of masses 1e9 and 1 with a contact given twice. It takes ``M`` dense; a sparse
+    problem keeps the LCP's failure. A spent budget stops the solve.
+    """
+    tol, polish = options["tol"], options["polish"]
+    try:
+        return solve_lcp(problem.delassus, q, tol, polish, decoupled=problem.decoupled)
+    except BudgetExceeded:
+        raise
+    except SolverFailure as failure:
+        if problem.sparse:
+            raise
+        try:
+            return project_in_kinetic_metric(
+                problem.M, problem.v, problem.Wn, problem.delassus, q, tol, polish
+            )
+        except BudgetExceeded:
+            raise
+        except SolverFailure as second:
+            raise SolverFailure(f"{second} (after the LCP: {failure})") from None
 
 
 UNDAMPED = 20

@@ -1,23 +1,16 @@
-"""Moreau's frictionless impact as a projection in the velocities or an LCP in the impulses.
+"""Moreau's plastic frictionless impact of many contacts as a projection in the velocities.
 
-Which of them answers is `Moreau._resolve`'s choice (the law's docstring); here each is solved
-with clarabel and polished, and handed on where clarabel fails for want of precision.
+Whether it answers is `Moreau._resolve`'s choice (the law's docstring); where clarabel fails
+for want of precision it hands the impact on to the LCP in the impulses (`Moreau`'s `_lcp`).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from lawbench.core.errors import BudgetExceeded, SolverFailure
 from lawbench.core.problem import ImpactProblem
-from lawbench.numerics.solvers import (
-    LCPResult,
-    project_in_kinetic_metric,
-    project_on_cone,
-    solve_lcp,
-)
+from lawbench.numerics.solvers import LCPResult, project_on_cone
 
 
 def projected(problem: ImpactProblem, options: dict[str, Any]) -> LCPResult | None:
@@ -42,29 +35,3 @@ def projected(problem: ImpactProblem, options: dict[str, Any]) -> LCPResult | No
         raise
     except SolverFailure:
         return None
-
-
-def lcp(problem: ImpactProblem, q: np.ndarray, options: dict[str, Any]) -> LCPResult:
-    """The LCP in the impulses, or where clarabel fails on it, the projection it is.
-
-    The projection in the kinetic metric (`project_in_kinetic_metric`) holds ``M``'s condition
-    in its constraints' square root, where the LCP holds all of it in its Hessian: a chain of
-    balls of masses 1e9 and 1 with a contact given twice. It takes ``M`` dense; a sparse
-    problem keeps the LCP's failure. A spent budget stops the solve.
-    """
-    tol, polish = options["tol"], options["polish"]
-    try:
-        return solve_lcp(problem.delassus, q, tol, polish, decoupled=problem.decoupled)
-    except BudgetExceeded:
-        raise
-    except SolverFailure as failure:
-        if problem.sparse:
-            raise
-        try:
-            return project_in_kinetic_metric(
-                problem.M, problem.v, problem.Wn, problem.delassus, q, tol, polish
-            )
-        except BudgetExceeded:
-            raise
-        except SolverFailure as second:
-            raise SolverFailure(f"{second} (after the LCP: {failure})") from None

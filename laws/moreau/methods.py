@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core.budget import current_budget
 from lawbench.core.errors import BudgetExceeded, SolverFailure
+from lawbench.core.guards import current_budget
 
 # Contacts up to which method auto solves an impact by the fixed point: beyond, a sweep costs a
 # fraction of a cone QP (82 stacked boxes: 43 sweeps in 0.05 s, 11 cone QPs in 5.6 s).
