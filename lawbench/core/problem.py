@@ -29,7 +29,6 @@ from lawbench.core.metric import (
     checked_gaps,
     checked_matrix,
     checked_range,
-    checked_sparse_matrix,
     closed_gaps,
     in_units,
     is_diagonal,
@@ -38,6 +37,7 @@ from lawbench.core.metric import (
     read_only_finite,
     solving_units,
 )
+from lawbench.core.sparse import checked_sparse_matrix
 
 # The kinds of restitution coefficient and the contact field that overrides ``e`` for each:
 # Newton's kinematic, Poisson's kinetic, Stronge's energetic coefficient.
@@ -503,11 +503,9 @@ class ImpactProblem:
 
         Blocks: ``[[Gnn, Gnt], [Gtn, Gtt]]`` with the m normal rows first, then the m*d
         tangential rows (contact j's tangential rows are ``m + j*d ... m + j*d + d - 1``).
-        Sparse for a sparse problem.
+        Sparse for a sparse problem; an entry of ``Wt`` that overflows is refused by name.
         """
-        if self.sparse:
-            return self.metric.sparse_delassus(self.W)
-        return self.metric.symmetric_product(self.W)
+        return self.metric.contact_delassus(self.W, self.Wt, self.m)
 
     @cached
     def ut(self) -> np.ndarray:
