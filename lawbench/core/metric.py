@@ -410,7 +410,7 @@ class KineticMetric:
         the columns of the whole Jacobian ``W`` give the scale of a test at rounding level.
         It reads ``W`` over a power of two near its largest entry: Jacobians of 1e200 are judged
         by their geometry. An entry that over- or underflows is no singular one: it is refused
-        by name, an overflow only where it overflows in the mass unit of `solving_units` too.
+        by name where it does so in the mass unit of `solving_units` too.
 
         Raises
         ------
@@ -420,7 +420,7 @@ class KineticMetric:
         """
         sparse = is_sparse(W)
         for j in np.flatnonzero(~np.isfinite(normal)):
-            self._refuse_overflow_in_units(Wn, int(j))
+            self._refuse_beyond_range_in_units(Wn, int(j), "overflows")
         largest = float(abs(W).max() if sparse else max(W.max(), -W.min())) if W.size else 0.0
         scale = unit_near(largest)
         scaled = W if scale == 1.0 else W / scale
@@ -447,22 +447,21 @@ class KineticMetric:
                     f"Wn[:, {j}] = {normal[j]:.3g}): a singular configuration"
                 )
             if normal[j] < np.finfo(float).tiny:
-                # Impulses of un / W would then overflow: refused in whatever unit of mass.
-                raise InvalidProblem(self._beyond_range("Wn", j, column, "underflows"))
+                self._refuse_beyond_range_in_units(Wn, j, "underflows")
 
     @staticmethod
     def _column(W: Any, k: int) -> np.ndarray:
         """Column ``k`` of a dense or sparse ``W`` as an array."""
         return W[:, [k]].toarray().ravel() if is_sparse(W) else W[:, k]
 
-    def _refuse_overflow_in_units(self, Wn: Any, j: int) -> None:
-        """Refuse contact ``j``'s overflowing entry unless a scale-free law's mass unit reads it."""
+    def _refuse_beyond_range_in_units(self, Wn: Any, j: int, what: str) -> None:
+        """Refuse contact ``j``'s entry that ``what``, unless the solving mass unit reads it."""
         column = self._column(Wn, j)
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             # A power of two: the product rounds nothing that does not leave the range.
             entry = float(column.dot(self.solve(column * mass_unit(self.M))))
-        if not entry < math.inf:
-            raise InvalidProblem(self._beyond_range("Wn", j, column, "overflows"))
+        if not np.finfo(float).tiny <= entry < math.inf:
+            raise InvalidProblem(self._beyond_range("Wn", j, column, what))
 
     def refuse_overflow(self, label: str, W: Any, diagonal: np.ndarray) -> None:
         """Refuse a Jacobian ``W`` (the field ``label``) whose Delassus diagonal overflows.
@@ -491,13 +490,14 @@ UNIT_BAND = 2.0**30
 
 
 def binary_scale(size: float) -> float:
-    """The power of two nearest ``size`` (1 for zero or a non-finite size).
+    """The power of two nearest ``size`` (1 for zero or a non-finite size), at most 2^1023.
 
     Multiplying by it is exact (no digit is rounded) wherever no number under- or overflows.
+    Sizes beyond 2^1023.5 (1.7e308) round to 2^1024, which no double holds: they take 2^1023.
     """
     if not math.isfinite(size) or size <= 0.0:
         return 1.0
-    return math.ldexp(1.0, round(math.log2(size)))
+    return math.ldexp(1.0, min(round(math.log2(size)), sys.float_info.max_exp - 1))
 
 
 def unit_near(size: float) -> float:
