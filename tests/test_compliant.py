@@ -178,6 +178,12 @@ def test_scales_beyond_double_precision_are_refused_by_name(mass, normal, speed)
         lawbench.solve("compliant", problem)
 
 
+def test_a_gap_beyond_double_precision_in_the_indentation_scale_is_refused():
+    """A gap of 1.7e308 m over an indentation of 0.8 m overflowed scipy's initial state."""
+    with pytest.raises(lawbench.NotApplicable, match=r"a gap of 1\.7e\+308 m"):
+        lawbench.solve("compliant", "ball_chain", gaps=[1.7e308])
+
+
 def test_budgets_end_with_a_solver_failure():
     with pytest.raises(lawbench.SolverFailure, match="step budget ran out"):
         lawbench.solve("compliant", "ball_chain", {"max_steps": 10}, n=10)

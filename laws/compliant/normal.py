@@ -125,7 +125,7 @@ class Integration:
         self.band = (stored * (self.n + 1) / self.k) ** (1 / (self.n + 1)) / self.L
 
     def _refuse_scales_beyond_range(self) -> None:
-        """Refuse an impact whose length, time or impulse scale leaves double precision.
+        """Refuse an impact whose length, time, impulse or gap scale leaves double precision.
 
         The integration runs in the problem's own units, scaled by these: an approach of 1e160
         m/s on a Delassus entry of 1e20 has an indentation scale the square of the speed
@@ -140,6 +140,12 @@ class Integration:
                     f"{self.V:.3g}, largest Delassus entry {self.G_max:.3g}): give it in units "
                     "near its masses and speeds"
                 )
+        gap = float(self.problem.gaps.max())
+        if not gap / self.L < math.inf:
+            raise NotApplicable(
+                f"compliant: a gap of {gap:.3g} m over the indentation scale ({self.L:.3g} m) "
+                "leaves double precision, and the integration reads gaps in that scale"
+            )
 
     def _initial_damping(self, G: np.ndarray) -> np.ndarray:
         c = self.given_damping.copy()
