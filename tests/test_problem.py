@@ -1,6 +1,7 @@
 """Validation of impact problems, case parameters and law options."""
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -177,6 +178,19 @@ def test_a_delassus_matrix_beyond_double_precision_is_named_not_called_singular(
     with pytest.raises(InvalidProblem, match=message):
         problem = ImpactProblem.from_arrays(M, Wn, [1e-150, 0.0], Wt=Wt, mu=0.5)
         problem.contact_delassus  # noqa: B018 - built on first read, where Wt overflows
+
+
+@pytest.mark.parametrize(
+    ("scale", "normal", "speed", "name"),
+    [(1e-300, 1e150, 1e300, "Wn.T v"), (1e300, 1.0, 1e150, "M v"), (1.0, 1.0, 1e300, "v M v / 2")],
+)
+def test_a_velocity_whose_gap_rates_or_momentum_overflow_is_refused_by_name(
+    scale, normal, speed, name
+):
+    """Gap rates of 1e450 read as a NaN un+ in the admissibility check: a solver failure."""
+    M = np.array([[2.0, 1.0], [1.0, 2.0]]) * scale
+    with pytest.raises(InvalidProblem, match=re.escape(f"{name} is beyond double precision")):
+        ImpactProblem.from_arrays(M, [[-normal], [normal]], [speed, speed / 2])
 
 
 def test_a_jacobian_of_extreme_scale_is_judged_by_its_geometry():

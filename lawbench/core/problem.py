@@ -25,6 +25,7 @@ from lawbench.core.geometry import Geometry
 from lawbench.core.metric import (
     SMALL,
     KineticMetric,
+    all_finite,
     cached,
     checked_gaps,
     checked_matrix,
@@ -337,14 +338,16 @@ class ImpactProblem:
             raise InvalidProblem(f"geometry is {type(geometry).__name__}, not Geometry")
         state["geometry"] = geometry
         state["metric"] = KineticMetric(self.M)
-        # Where M^-1 or v is extreme, the Delassus matrix and the energy overflow: both are
-        # refused below by name, not with a warning.
+        # Where M^-1 or v is extreme, the Delassus matrix, the energy and the gap rates
+        # overflow: each is refused by name, not with a warning.
         with np.errstate(over="ignore", invalid="ignore"):
             self._check_normals()
             momentum = self.M.dot(self.v)
             T_minus = float(self.v.dot(momentum)) / 2.0
-        if not math.isfinite(T_minus):
-            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({T_minus})")
+            rates = {"M v": momentum, "v M v / 2": T_minus, "Wn.T v": self.un, "Wt.T v": self.ut}
+        for name, value in rates.items():
+            if not all_finite(np.asarray(value)):
+                raise InvalidProblem(f"{name} is beyond double precision (it overflows)")
         momentum.setflags(write=False)
         state.update(momentum=momentum, T_minus=T_minus)
 
