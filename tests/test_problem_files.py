@@ -1,6 +1,7 @@
 """Problems in files: every scene round-trips through JSON, NPZ and HDF5, bit for bit."""
 
 import json
+import math
 import subprocess
 import sys
 
@@ -198,6 +199,16 @@ def test_an_array_file_with_an_unknown_array_or_a_wrong_flag_is_refused(tmp_path
     path = save_problem(lawbench.CASES.get("ball_chain").build(n=4), tmp_path / "ok.npz")
     np.savez(tmp_path / "bad.npz", **dict(np.load(path, allow_pickle=False)), **arrays)
     with pytest.raises(lawbench.InvalidProblem, match=message):
+        load_problem(tmp_path / "bad.npz")
+
+
+@pytest.mark.parametrize("shape", [[1e300, 40], [math.inf, 40], [40.0, 40.0], [4, 1, 1], [-4, 40]])
+def test_a_sparse_shape_that_is_not_two_non_negative_integers_is_refused(tmp_path, shape):
+    """A claimed shape of 1e300 or inf was an OverflowError converting it to an integer."""
+    path = save_problem(lawbench.CASES.get("ball_chain").build(n=80), tmp_path / "ok.npz")
+    arrays = dict(np.load(path, allow_pickle=False))
+    np.savez(tmp_path / "bad.npz", **{**arrays, "M.shape": np.array(shape)})
+    with pytest.raises(lawbench.InvalidProblem, match="field 'M': its shape"):
         load_problem(tmp_path / "bad.npz")
 
 

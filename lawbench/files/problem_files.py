@@ -342,7 +342,7 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> _Re
             data[name] = np.asarray(get(name))
             storage.append((name, "dense"))
         elif f"{name}.data" in names:
-            shape = tuple(int(s) for s in np.asarray(get(f"{name}.shape")))
+            shape = _shape(np.asarray(get(f"{name}.shape")), name, where)
             matrix = scipy.sparse.csr_matrix(
                 (get(f"{name}.data"), get(f"{name}.indices"), get(f"{name}.indptr")), shape
             )
@@ -357,6 +357,16 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> _Re
             data[name] = matrix if sparse else _dense(matrix, name, where)
             storage.append((name, "compressed rows"))
     return _Read(data, tuple(storage), where)
+
+
+def _shape(value: np.ndarray, name: str, where: Path) -> tuple[int, int]:
+    """The shape a CSR triplet claims: two non-negative integers (of any integer dtype)."""
+    if value.shape != (2,) or value.dtype.kind not in "iu" or (value < 0).any():
+        raise InvalidProblem(
+            f"{where}: field {name!r}: its shape {value.tolist()!r} is not two non-negative "
+            "integers"
+        )
+    return int(value[0]), int(value[1])
 
 
 def _dense(matrix: scipy.sparse.csr_matrix, name: str, where: Path) -> np.ndarray:
