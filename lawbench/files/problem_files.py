@@ -13,6 +13,9 @@ The format (version 1) holds one `ImpactProblem`:
 | ``gaps`` | (m,) initial gaps |
 | ``bodies`` | body name -> indices of its coordinates |
 | ``contacts`` | one entry per contact: every field of `lawbench.Contact` (null where unset) |
+| ``sparse`` | optional, true or false: whether the matrices are read back as scipy.sparse |
+
+Any other key (array, in NPZ and HDF5) is refused, naming it.
 
 Sign conventions as everywhere in lawbench: ``un < 0`` approaches, ``Pn >= 0`` pushes apart,
 ``v_plus = v + M^-1 (Wn Pn + Wt Pt)``.
@@ -22,9 +25,9 @@ written with Python's shortest round-trip repr, so every float is read back bit 
 ``.npz`` and ``.h5``/``.hdf5`` hold arrays; a matrix whose entries are mostly zero (sparse
 chains) is stored as CSR triplets (``<name>.data``, ``.indices``, ``.indptr``, ``.shape``), so a
 large sparse problem stays small on disk. A problem built with scipy.sparse matrices is marked
-``sparse`` (true) and read back with them; JSON writes its matrices dense. ``bodies`` and
-``contacts`` are stored as JSON text in the array files. HDF5 needs h5py
-(``pip install 'lawbench[hdf5]'``).
+``sparse`` (true) and read back with them; JSON writes its matrices dense, and reads them back
+sparse where a file is marked so by hand. ``bodies`` and ``contacts`` are stored as JSON text in
+the array files. HDF5 needs h5py (``pip install 'lawbench[hdf5]'``).
 """
 
 from __future__ import annotations
