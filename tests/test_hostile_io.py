@@ -229,6 +229,18 @@ def test_run_files_refuse_a_bad_generator_or_transform_naming_it(entry, message)
 RUN = ["run", "--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial", "--quiet"]
 
 
+@pytest.mark.parametrize(("laws", "e"), [("newton,newton", "e=0"), ("newton", "e=0,0")])
+def test_a_cell_named_twice_is_computed_once_and_the_table_written(tmp_path, capsys, laws, e):
+    """The table held one row per cell and waited for two: the run said '1 row in OUT' and
+    exited 0, and no OUT was ever written."""
+    out = tmp_path / "t.csv"
+    argv = ["run", "--laws", laws, "--cases", "three_ball_chain", "--param", e, "--out", out]
+    code, _, err = run_cli([*argv, "--executor", "serial", "--quiet"], capsys)
+    assert code == 0, err
+    assert len(lawbench.load_run(out)) == 1
+    assert not (tmp_path / "t.csv.parts").exists()
+
+
 def test_resume_refuses_a_users_own_table_and_one_whose_rows_changed(tmp_path, capsys):
     own = tmp_path / "own.csv"
     own.write_text("key,a\nx,1\ny,2\n")
