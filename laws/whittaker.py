@@ -100,6 +100,10 @@ if TYPE_CHECKING:
 MAX_ENUMERATED = 4
 # Relative tolerance of the law's conditions on a candidate solution.
 TOLERANCE = 1e-9
+# The largest friction coefficient treated: the cone rows ``Pt -+ mu Pn`` are normalized by
+# their norm ``sqrt(1 + mu^2)``, and the slip quartic's coefficients grow as mu, so beyond
+# about 1e154 they leave double precision.
+MU_RANGE = 1e150
 CHOICE = "least post-impact kinetic energy (first listed on a tie)"
 _PLANAR_SLIPS = (np.array([1.0]), np.array([-1.0]))
 
@@ -429,6 +433,11 @@ class Whittaker(Law):
             raise NotApplicable(
                 f"whittaker: {problem.m} spatial contacts; the impulse-level Coulomb law with "
                 "circular cones is not an LCP and only one spatial contact is treated"
+            )
+        if problem.mu.max() > MU_RANGE:
+            raise NotApplicable(
+                f"whittaker: mu = {problem.mu.max():.3g}: its impulse-level cone leaves double "
+                f"precision beyond mu = {MU_RANGE:g}"
             )
         setup = _Setup.of(problem, friction=True)
         extra: dict[str, Any] = {"coupling": setup.coupling()}

@@ -88,6 +88,24 @@ def test_bad_batches_name_the_field_and_the_problem(field, value, message):
         lawbench.ProblemBatch(arrays["M"], Wn, arrays["v"], coefficients)
 
 
+@pytest.mark.parametrize(
+    ("mass", "normal", "message"),
+    [(1e-200, 1e200, "problem 1: .* Wn overflows"), (1.0, 1e-200, "problem 1: .* Wn underflows")],
+)
+def test_a_batch_names_a_delassus_entry_beyond_double_precision(mass, normal, message):
+    """As `ImpactProblem`: an entry of 2e600 or 2e-500 is beyond range, not singular."""
+    M = np.stack([np.eye(2), np.eye(2) * mass])
+    Wn = np.stack([[[-1.0], [1.0]], [[-normal], [normal]]])
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        lawbench.ProblemBatch(M, Wn, np.array([[1.0, 0.0], [1.0, 0.0]]))
+
+
+def test_a_batch_of_an_extreme_jacobian_is_judged_by_its_geometry():
+    """Wn of 1e160 on masses of 1e300: W = 2e20, though the squares of Wn overflow."""
+    batch = lawbench.ProblemBatch(np.eye(2)[None] * 1e300, [[[-1e160], [1e160]]], [[1.0, 0.0]])
+    assert batch.delassus[0, 0, 0] == pytest.approx(2e20)
+
+
 @pytest.mark.parametrize("m", [2, 3, 4, 6])
 def test_enumeration_solves_the_lcp_exactly(m):
     """Against Lawson-Hanson NNLS (finite and exact): same z, and w = Gz + q complementary."""

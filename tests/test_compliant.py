@@ -166,6 +166,24 @@ def test_stiff_extremes_give_a_finite_answer(ratio):
     assert abs(outcome.dT) <= 1e-8 * outcome.T_minus
 
 
+@pytest.mark.parametrize(
+    ("mass", "normal", "speed"), [(1e300, 1e160, 1.0), (1.0, 1.0, 1e-300)], ids=["huge", "tiny"]
+)
+def test_scales_beyond_double_precision_are_refused_by_name(mass, normal, speed):
+    """The law integrates in the problem's own units: an approach of 1e160 m/s squares past
+    the largest double, one of 1e-300 m/s to zero, and the refusal says so."""
+    Wn = [[-normal], [normal]]
+    problem = ImpactProblem.from_arrays(np.eye(2) * mass, Wn, [speed, 0.0])
+    with pytest.raises(lawbench.NotApplicable, match="indentation scale leaves double"):
+        lawbench.solve("compliant", problem)
+
+
+def test_a_gap_beyond_double_precision_in_the_indentation_scale_is_refused():
+    """A gap of 1.7e308 m over an indentation of 0.8 m overflowed scipy's initial state."""
+    with pytest.raises(lawbench.NotApplicable, match=r"a gap of 1\.7e\+308 m"):
+        lawbench.solve("compliant", "ball_chain", gaps=[1.7e308])
+
+
 def test_budgets_end_with_a_solver_failure():
     with pytest.raises(lawbench.SolverFailure, match="step budget ran out"):
         lawbench.solve("compliant", "ball_chain", {"max_steps": 10}, n=10)

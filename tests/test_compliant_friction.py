@@ -213,3 +213,10 @@ def test_a_slip_that_stops_at_a_graze_sticks_without_chattering():
     assert relative(trial.outcome.v_plus, reference, problem.v) <= 1e-7
     checks = lawbench.run_checks(trial, checks=["energy_gain", "friction_cone", "momentum"])
     assert {str(result.verdict) for result in checks.values()} == {"holds"}
+
+
+def test_a_tangential_spring_beyond_double_precision_is_refused_by_name():
+    """A force exponent of 5e-324 makes the tangential stiffness n k d^(n - 1) subnormal and
+    its Coulomb bound infinite: scipy's integrator was handed a non-finite state."""
+    with pytest.raises(lawbench.NotApplicable, match="tangential spring"):
+        lawbench.solve("compliant", "billiard", exponent=5e-324)

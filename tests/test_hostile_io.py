@@ -5,7 +5,9 @@ form whose ``f`` is shorter than ``M``, a matrix that claims a billion rows, a `
 an indefinite or skew ``W``, ``mu = 1e300``); the standard streams closed, broken, full or
 narrow; outputs on a full disk, under ``/sys`` or behind a symlink; resuming onto a table no run
 wrote; run files with a negative seed, a fractional count or bad continuity sizes, options of a law
-that has no cell in their grid, a check named twice.
+that has no cell in their grid, a check named twice. Every scene at the extremes of each of its
+declared parameters (its bounds and just beyond, 0, subnormal, huge, negative, NaN, infinite,
+text): an answer whose checks hold, or a refusal.
 """
 
 import errno
@@ -20,6 +22,7 @@ import pytest
 
 import lawbench
 from lawbench.core.mechanics import fc3d_error
+from lawbench.core.verdicts import ACCEPTABLE
 from lawbench.files.problem_files import load_problem
 from lawbench.studies.grid import RunSpec
 from lawbench.views.cli import main
@@ -226,6 +229,18 @@ def test_run_files_refuse_a_bad_generator_or_transform_naming_it(entry, message)
 RUN = ["run", "--laws", "newton", "--cases", "three_ball_chain", "--executor", "serial", "--quiet"]
 
 
+@pytest.mark.parametrize(("laws", "e"), [("newton,newton", "e=0"), ("newton", "e=0,0")])
+def test_a_cell_named_twice_is_computed_once_and_the_table_written(tmp_path, capsys, laws, e):
+    """The table held one row per cell and waited for two: the run said '1 row in OUT' and
+    exited 0, and no OUT was ever written."""
+    out = tmp_path / "t.csv"
+    argv = ["run", "--laws", laws, "--cases", "three_ball_chain", "--param", e, "--out", out]
+    code, _, err = run_cli([*argv, "--executor", "serial", "--quiet"], capsys)
+    assert code == 0, err
+    assert len(lawbench.load_run(out)) == 1
+    assert not (tmp_path / "t.csv.parts").exists()
+
+
 def test_resume_refuses_a_users_own_table_and_one_whose_rows_changed(tmp_path, capsys):
     own = tmp_path / "own.csv"
     own.write_text("key,a\nx,1\ny,2\n")
@@ -307,3 +322,56 @@ def test_out_of_memory_is_one_line_and_exit_4(capsys, monkeypatch):
     monkeypatch.setattr(listing, "run", exhausted)
     code, _, err = run_cli(["list"], capsys)
     assert code == 4 and "out of memory" in err and one_line(err)
+
+
+def extremes(spec):
+    """Values of a scene parameter at its bounds, just beyond them, and far from them."""
+    values = []
+    for bound, direction in ((spec.low, -1.0), (spec.high, 1.0)):
+        if bound is not None:
+            values += [bound, float(np.nextafter(bound, direction * math.inf))]
+    values += [0.0, 5e-324, 1e-300, 1.7e308, -1e300, math.nan, math.inf, "abc"]
+    if spec.kind == "floats":
+        return [
+            value if isinstance(value, str) else [value] * len(spec.default) for value in values
+        ]
+    if spec.kind == "int":
+        return [spec.low, spec.high + 1, spec.low - 1, 1.5, "abc"]
+    return [True, False, "maybe", 2] if spec.kind == "bool" else values
+
+
+def answers_or_refuses(law, scene, name, value, seconds):
+    """An answer whose single-solve checks are all acceptable, or a one-line `LawbenchError`."""
+    try:
+        trial = lawbench.evaluate(law, scene, {"max_seconds": seconds}, **{name: value})
+    except lawbench.LawbenchError as exc:
+        assert "\n" not in str(exc) and str(exc), repr(exc)
+        return
+    assert np.isfinite(trial.outcome.v_plus).all()
+    verdicts = {key: check.verdict for key, check in lawbench.run_checks(trial).items()}
+    assert set(verdicts.values()) <= ACCEPTABLE, verdicts
+
+
+SCENE_PARAMETERS = [
+    (scene.name, spec.name, value)
+    for scene in lawbench.CASES.values()
+    for spec in scene.params
+    for value in extremes(spec)
+]
+
+
+@pytest.mark.parametrize(("law", "share"), [("newton", 1), ("moreau", 5)])
+def test_every_scene_at_the_extremes_of_its_parameters_answers_or_refuses(law, share):
+    """The cheap part: Newton's law at every extreme, Moreau's at one in five, each within a
+    short budget (running out of it is a refusal)."""
+    for scene, name, value in SCENE_PARAMETERS[::share]:
+        answers_or_refuses(law, scene, name, value, 0.5)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "law", ["newton", "moreau", "lzb", "compliant", "jia", "poisson", "whittaker"]
+)
+@pytest.mark.parametrize(("scene", "name", "value"), SCENE_PARAMETERS, ids=str)
+def test_every_scene_at_every_extreme_answers_or_refuses_with_every_law(law, scene, name, value):
+    answers_or_refuses(law, scene, name, value, 2)

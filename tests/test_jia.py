@@ -535,3 +535,9 @@ def test_contacts_of_different_exponents_are_refused():
     )
     with pytest.raises(lawbench.NotApplicable, match=r"force exponents differ \(1, 1\.5\)"):
         LAW.resolve(problem)
+
+
+def test_a_spring_whose_period_leaves_double_precision_is_refused_by_name():
+    """A stiffness ratio of 5e-324 gave a frequency of 0: a ZeroDivisionError inside the law."""
+    with pytest.raises(lawbench.NotApplicable, match="period beyond double precision"):
+        lawbench.solve("jia", "two_balls_wall", stiffness_ratio=5e-324)

@@ -1,6 +1,7 @@
 """Validation of impact problems, case parameters and law options."""
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -161,6 +162,41 @@ def test_a_contact_no_motion_can_push_along_its_normal_is_refused():
         lawbench.CASES.get("double_pendulum").build(angles=[1e-6, 0.0], omegas=[-1.0, 3.0])
     nearly = lawbench.CASES.get("double_pendulum").build(angles=[1e-3, 0.0], omegas=[-1.0, 3.0])
     assert nearly.delassus[0, 0] > 0
+
+
+@pytest.mark.parametrize(
+    ("M", "Wn", "Wt", "message"),
+    [
+        (np.eye(2) * 1e-200, [[-1e200], [1e200]], None, r"Wn\[:, 0\]: .* Wn overflows"),
+        (np.eye(2), [[-1e-200], [1e-200]], None, r"Wn\[:, 0\]: .* Wn underflows"),
+        (np.eye(2) * 1e-5, [[-1e150], [1e150]], [[1e154], [1e154]], r"Wt\[:, 0\]: .* overflows"),
+    ],
+    ids=["overflow", "underflow", "tangential"],
+)
+def test_a_delassus_matrix_beyond_double_precision_is_named_not_called_singular(M, Wn, Wt, message):
+    """W = Wn.T M^-1 Wn of 2e400 or 2e-500 is no singular configuration: it names the field."""
+    with pytest.raises(InvalidProblem, match=message):
+        problem = ImpactProblem.from_arrays(M, Wn, [1e-150, 0.0], Wt=Wt, mu=0.5)
+        problem.contact_delassus  # noqa: B018 - built on first read, where Wt overflows
+
+
+@pytest.mark.parametrize(
+    ("scale", "normal", "speed", "name"),
+    [(1e-300, 1e150, 1e300, "Wn.T v"), (1e300, 1.0, 1e150, "M v"), (1.0, 1.0, 1e300, "v M v / 2")],
+)
+def test_a_velocity_whose_gap_rates_or_momentum_overflow_is_refused_by_name(
+    scale, normal, speed, name
+):
+    """Gap rates of 1e450 read as a NaN un+ in the admissibility check: a solver failure."""
+    M = np.array([[2.0, 1.0], [1.0, 2.0]]) * scale
+    with pytest.raises(InvalidProblem, match=re.escape(f"{name} is beyond double precision")):
+        ImpactProblem.from_arrays(M, [[-normal], [normal]], [speed, speed / 2])
+
+
+def test_a_jacobian_of_extreme_scale_is_judged_by_its_geometry():
+    """Wn of 1e160 on masses of 1e300: W = 2e20, no contact singular (its squares overflow)."""
+    problem = ImpactProblem.from_arrays(np.eye(2) * 1e300, [[-1e160], [1e160]], [1.0, 0.0])
+    assert problem.delassus[0, 0] == pytest.approx(2e20)
 
 
 def test_a_large_diagonal_mass_gives_the_dense_delassus_matrix():

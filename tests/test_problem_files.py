@@ -1,6 +1,7 @@
 """Problems in files: every scene round-trips through JSON, NPZ and HDF5, bit for bit."""
 
 import json
+import math
 import subprocess
 import sys
 
@@ -161,6 +162,62 @@ def test_json_numbers_no_double_holds_and_unset_coefficients_are_refused(
         load_problem(path)
     assert cli.main(["solve", "moreau", "--problem", str(path)]) == 2
     assert len(capsys.readouterr().err.splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ({"colour": "red"}, "unknown key 'colour'; known: format"),
+        ({"sparse": "yes"}, "field 'sparse' = 'yes': must be true or false"),
+        ({"sparse": 1.5}, "field 'sparse' = 1.5: must be true or false"),
+        ({"version": True}, "version True is not supported"),
+    ],
+)
+def test_a_json_file_with_an_unknown_key_or_a_wrong_flag_is_refused_by_name(
+    tmp_path, capsys, extra, message
+):
+    """Keys and flags were read only where known: a misspelt key or a flag of "yes" passed."""
+    from lawbench.views import cli
+
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps({**GOOD, **extra}))
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        load_problem(path)
+    assert cli.main(["solve", "moreau", "--problem", str(path)]) == 2
+    assert len(capsys.readouterr().err.splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("arrays", "message"),
+    [
+        ({"sparse": np.array("yes")}, "field 'sparse' = array"),
+        ({"sparse": np.array([True, False])}, "field 'sparse' = array"),
+        ({"colour": np.array(1.0)}, "unknown array 'colour'"),
+    ],
+)
+def test_an_array_file_with_an_unknown_array_or_a_wrong_flag_is_refused(tmp_path, arrays, message):
+    path = save_problem(lawbench.CASES.get("ball_chain").build(n=4), tmp_path / "ok.npz")
+    np.savez(tmp_path / "bad.npz", **dict(np.load(path, allow_pickle=False)), **arrays)
+    with pytest.raises(lawbench.InvalidProblem, match=message):
+        load_problem(tmp_path / "bad.npz")
+
+
+@pytest.mark.parametrize("shape", [[1e300, 40], [math.inf, 40], [40.0, 40.0], [4, 1, 1], [-4, 40]])
+def test_a_sparse_shape_that_is_not_two_non_negative_integers_is_refused(tmp_path, shape):
+    """A claimed shape of 1e300 or inf was an OverflowError converting it to an integer."""
+    path = save_problem(lawbench.CASES.get("ball_chain").build(n=80), tmp_path / "ok.npz")
+    arrays = dict(np.load(path, allow_pickle=False))
+    np.savez(tmp_path / "bad.npz", **{**arrays, "M.shape": np.array(shape)})
+    with pytest.raises(lawbench.InvalidProblem, match="field 'M': its shape"):
+        load_problem(tmp_path / "bad.npz")
+
+
+def test_a_json_file_marked_sparse_is_read_with_sparse_matrices(tmp_path):
+    problem = lawbench.CASES.get("ball_chain").build(n=80)
+    path = save_problem(problem, tmp_path / "chain.json")
+    path.write_text(json.dumps({**json.loads(path.read_text()), "sparse": True}))
+    loaded = load_problem(path)
+    assert loaded.sparse and np.array_equal(loaded.M.toarray(), problem.M)
 
 
 @pytest.mark.parametrize("sparse", [False, True], ids=["dense", "marked sparse"])

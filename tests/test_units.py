@@ -103,6 +103,22 @@ def test_a_law_that_reads_a_damping_refuses_what_overflows_its_own_units():
         lawbench.LAWS.get("compliant").resolve(problem)
 
 
+def test_masses_at_the_largest_double_take_the_largest_power_of_two_as_unit():
+    """Masses of 1.7e308 kg round to 2^1024 kg, which no double holds: the unit is 2^1023."""
+    chain = lawbench.CASES.get("three_ball_chain")
+    problem = chain.build(masses=[1.7e308] * 3, velocities=[1e-3, 0.0, 0.0])
+    assert problem.units[0] == 2.0**1023
+    outcome = lawbench.LAWS.get("newton").resolve(problem)
+    np.testing.assert_allclose(outcome.v_plus, [-1e-3 / 3, 2e-3 / 3, 2e-3 / 3], rtol=1e-12)
+
+
+def test_an_answer_that_overflows_in_the_problems_units_names_the_units():
+    """W = 2e-200 in the solving mass unit, impulses of 1e400 in the problem's own."""
+    problem = ImpactProblem.from_arrays(np.eye(2) * 1e300, [[-1e-100], [1e-100]], [1.0, 0.0])
+    with pytest.raises(lawbench.InvalidProblem, match=r"Pn, found in units .* leaves double"):
+        lawbench.LAWS.get("newton").resolve(problem)
+
+
 @pytest.mark.parametrize("light", [1e-20, 1e-200, 1e-308])
 def test_a_light_body_beside_heavy_ones_is_no_singular_configuration(light):
     """Masses (light, 1, 1) in the three-ball chain: each contact is judged on its own bodies.

@@ -659,3 +659,11 @@ def test_lemkes_rounding_never_leaves_a_contact_outside_its_cone():
     trial = lawbench.evaluate("whittaker", problem)
     assert trial.outcome.diagnostics["formulation"] == "Lemke LCP"
     assert lawbench.run_checks(trial, checks=["friction_cone"])["friction_cone"].passed
+
+
+@pytest.mark.parametrize("case", ["bouncing_ball", "falling_rod", "lamina"])
+def test_a_friction_coefficient_beyond_the_cones_range_is_refused_by_name(case):
+    """mu = 1.7e308 overflowed the slip quartic (a LinAlgError in numpy's roots) and the cone
+    rows of the planar modes (an invalid linear program)."""
+    with pytest.raises(lawbench.NotApplicable, match=r"mu = 1\.7e\+308"):
+        lawbench.solve("whittaker", case, mu=1.7e308)

@@ -165,18 +165,23 @@ class ProblemBatch:
 
         A normal Delassus entry at rounding level against the largest inverse mass (1 over
         ``smallest``, each M's smallest eigenvalue) times the largest squared column of the
-        whole Jacobian ``[Wn, Wt]``.
+        whole Jacobian ``[Wn, Wt]`` flags a problem; a flagged one is judged as an
+        `ImpactProblem`, whose test reads entries and columns beyond double precision (a
+        Delassus entry that overflows, squares of 1e160) by their scale.
         """
-        diagonal = np.einsum("kjj->kj", self.delassus)
-        columns = np.einsum("kij,kij->kj", self.Wn, self.Wn).max(axis=1)
-        if self.Wt is not None:
-            columns = np.maximum(columns, np.einsum("kij,kij->kj", self.Wt, self.Wt).max(axis=1))
-        floor = 1e-12 * columns / smallest
-        for k, j in np.argwhere(diagonal <= floor[:, None])[:1]:
-            raise InvalidProblem(
-                f"problem {k}: contacts[{j}]: no motion moves it along its normal "
-                f"(Wn[:, {j}] M^-1 Wn[:, {j}] = {diagonal[k, j]:.3g})"
-            )
+        with np.errstate(over="ignore", invalid="ignore"):
+            diagonal = np.einsum("kjj->kj", self.delassus)
+            columns = np.einsum("kij,kij->kj", self.Wn, self.Wn).max(axis=1)
+            if self.Wt is not None:
+                tangential = np.einsum("kij,kij->kj", self.Wt, self.Wt).max(axis=1)
+                columns = np.maximum(columns, tangential)
+            floor = 1e-12 * columns / smallest
+            flagged = ~(diagonal > floor[:, None]).all(axis=1)
+        for k in np.flatnonzero(flagged):
+            try:
+                self.problem(int(k))
+            except InvalidProblem as exc:
+                raise InvalidProblem(f"problem {k}: {exc}") from None
 
     def _factor_mass(self) -> np.ndarray:
         """Check every M and keep its inverse; return the smallest eigenvalue of each.

@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from lawbench.core.errors import BudgetExceeded, SolverFailure
+from lawbench.core.errors import BudgetExceeded, InvalidProblem, SolverFailure
 from lawbench.core.metric import all_finite
 from lawbench.core.outcome import Outcome, generalized_impulse
 from lawbench.core.problem import ImpactProblem
@@ -354,14 +354,26 @@ def _refuse_malformed(law: str, problem: ImpactProblem, outcome: Outcome) -> Non
             raise SolverFailure(f"{law}: v_minus is not the problem's velocity v")
 
 
+def refuse_beyond_units(name: str, units: tuple[float, float, float], **fields: Any) -> None:
+    """Raise `InvalidProblem` naming the first of ``fields`` that is not finite once scaled back.
+
+    A scale-free law answers in ``units`` (mass, velocity, time) near the impact's scales; an
+    answer that overflows in the problem's own units (impulses of 1e400 kg m/s) is a problem
+    beyond double precision there, not a failure of the law.
+    """
+    for field, value in fields.items():
+        if not _finite(value):
+            raise InvalidProblem(
+                f"{name}: the answer's {field}, found in units of {units[0]:g} kg and "
+                f"{units[1]:g} m/s, leaves double precision in the problem's own units: give "
+                "the problem in units nearer its masses and speeds"
+            )
+
+
 def refuse_non_finite(name: str, **fields: Any) -> None:
     """Raise `SolverFailure` naming the first of ``fields`` that holds a non-finite number."""
     for field, value in fields.items():
-        if isinstance(value, float):
-            finite = math.isfinite(value)
-        else:
-            finite = not value.size or all_finite(value)
-        if not finite:
+        if not _finite(value):
             raise SolverFailure(f"{name}: non-finite {field} {value}")
 
 
@@ -499,3 +511,8 @@ class Watch:
         if self.caught:
             heard = {f"{w.category.__name__}: {w.message}" for w in self.caught}
             self.record["warnings"] = sorted(heard)
+
+
+def _finite(value: Any) -> bool:
+    """Whether a float or an array holds only finite numbers."""
+    return math.isfinite(value) if isinstance(value, float) else not value.size or all_finite(value)

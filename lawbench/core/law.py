@@ -55,6 +55,7 @@ from lawbench.core.guards import (
     Watch,
     from_user,
     inputs,
+    refuse_beyond_units,
     refuse_non_finite,
     user_interrupts,
     verify_answer,
@@ -246,8 +247,9 @@ class Law(ABC):
             outcome = self._resolve_closed(solved, values)
         if solved is not problem:
             outcome = scaled_back(outcome, problem, units)
-            refuse_non_finite(  # scaled back, a number may overflow
+            refuse_beyond_units(  # scaled back, a number may overflow
                 self.name,
+                units,
                 v_plus=outcome.v_plus,
                 Pn=outcome.Pn,
                 Pt=outcome.Pt,

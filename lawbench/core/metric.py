@@ -147,7 +147,7 @@ def closed_gaps(m: int) -> np.ndarray:
     return gaps
 
 
-def _non_finite(value: float) -> str:
+def non_finite(value: float) -> str:
     """What a non-finite number is, in words (a message never shows a NaN of its own)."""
     return "is not a number" if math.isnan(value) else f"is {'-' if value < 0 else ''}infinite"
 
@@ -156,40 +156,9 @@ def read_only_finite(name: str, array: np.ndarray) -> np.ndarray:
     """Make ``array`` (the problem's own copy) read-only, or raise naming a non-finite entry."""
     if not all_finite(array):
         index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
-        raise InvalidProblem(f"{name}{list(index)} {_non_finite(array[index])}: must be finite")
+        raise InvalidProblem(f"{name}{list(index)} {non_finite(array[index])}: must be finite")
     array.setflags(write=False)
     return array
-
-
-def checked_sparse_matrix(name: str, value: object, shape: tuple[int, int]) -> Any:
-    """Return ``value`` as a read-only CSC array of ``shape``, or raise `InvalidProblem`.
-
-    The checks cost O(nnz): only the stored entries are read, and a sparse ``value``'s shape
-    before anything of its size is made (it may claim a billion columns).
-    """
-    import scipy.sparse
-
-    if is_sparse(value) and value.shape != shape:
-        raise InvalidProblem(f"{name} has shape {value.shape}, expected {shape}")
-    try:
-        matrix = scipy.sparse.csc_array(value, dtype=float, copy=True)
-    except (TypeError, ValueError) as exc:
-        raise InvalidProblem(f"{name}: not a matrix of numbers ({exc})") from None
-    if matrix.shape != shape:
-        raise InvalidProblem(f"{name} has shape {matrix.shape}, expected {shape}")
-    matrix.sum_duplicates()
-    bad = np.flatnonzero(~np.isfinite(matrix.data))
-    if bad.size:
-        k = int(bad[0])
-        column = int(np.searchsorted(matrix.indptr, k, side="right")) - 1
-        raise InvalidProblem(
-            f"{name}{[int(matrix.indices[k]), column]} {_non_finite(matrix.data[k])}: must be "
-            "finite"
-        )
-    matrix.eliminate_zeros()
-    for part in (matrix.data, matrix.indices, matrix.indptr):
-        part.setflags(write=False)
-    return matrix
 
 
 @np.errstate(over="ignore", invalid="ignore")
@@ -393,6 +362,20 @@ class KineticMetric:
         G.setflags(write=False)
         return G
 
+    def contact_delassus(self, W: Any, Wt: Any, m: int) -> Any:
+        """``W.T M^-1 W`` of a whole Jacobian ``W = [Wn, Wt]`` with m normal columns.
+
+        Raises
+        ------
+        InvalidProblem
+            Where a tangential entry overflows, naming the column of ``Wt`` (the normal block
+            is the Delassus matrix a problem checks when built).
+        """
+        with np.errstate(over="ignore", invalid="ignore"):
+            G = self.sparse_delassus(W) if is_sparse(W) else self.symmetric_product(W)
+        self.refuse_overflow("Wt", Wt, G.diagonal()[m:])
+        return G
+
     def symmetric_product(self, W: np.ndarray) -> np.ndarray:
         """``W.T M^-1 W`` of a dense ``W`` by one solve, symmetrized, read-only."""
         G = W.T.dot(self.solve(W))
@@ -425,30 +408,80 @@ class KineticMetric:
         hanging straight down onto the floor), and every law's impulse would be meaningless.
         The largest diagonal entry of M^-1, within a factor n of its largest eigenvalue, and
         the columns of the whole Jacobian ``W`` give the scale of a test at rounding level.
+        It reads ``W`` over a power of two near its largest entry: Jacobians of 1e200 are judged
+        by their geometry. An entry that over- or underflows is no singular one: it is refused
+        by name where it does so in the mass unit of `solving_units` too.
 
         Raises
         ------
         InvalidProblem
-            Naming the first such contact.
+            Naming the first singular contact, or the first whose entry is beyond double
+            precision in the problem's units and in the solving ones.
         """
         sparse = is_sparse(W)
+        for j in np.flatnonzero(~np.isfinite(normal)):
+            self._refuse_beyond_range_in_units(Wn, int(j), "overflows")
+        largest = float(abs(W).max() if sparse else max(W.max(), -W.min())) if W.size else 0.0
+        scale = unit_near(largest)
+        scaled = W if scale == 1.0 else W / scale
         # The squared Frobenius norm of W bounds its largest squared column: one product
         # settles the usual case.
-        frobenius = W.multiply(W).sum() if sparse else np.vdot(W, W)
-        if normal.min() > 1e-12 * self.largest_inverse * frobenius:
+        frobenius = scaled.multiply(scaled).sum() if sparse else np.vdot(scaled, scaled)
+        if normal.min() / scale / scale > 1e-12 * self.largest_inverse * frobenius:
             return
-        squares = W.multiply(W) if sparse else W * W
+        squares = scaled.multiply(scaled) if sparse else scaled * scaled
         columns = np.asarray(squares.sum(axis=0)).ravel()
         # Each contact against the inverse masses of the coordinates its normal moves: a light
         # body elsewhere (masses 1e-20 and 1 kg) makes no contact singular.
         geometry = 1e-12 * float(columns.max())
         for j in range(Wn.shape[1]):
-            column = Wn[:, [j]].toarray().ravel() if sparse else Wn[:, j]
-            if not normal[j] / self.inverse_mass_on(column) > geometry:
+            column = self._column(Wn, j)
+            inverse_mass = self.inverse_mass_on(column)
+            if normal[j] / scale / scale / inverse_mass > geometry:
+                continue
+            # Read again at the scale of W: an entry that underflowed is not a singular one.
+            unit = column / scale
+            if not float(unit.dot(self.solve(unit))) / inverse_mass > geometry:
                 raise InvalidProblem(
                     f"contacts[{j}]: no motion moves it along its normal (Wn[:, {j}] M^-1 "
                     f"Wn[:, {j}] = {normal[j]:.3g}): a singular configuration"
                 )
+            if normal[j] < np.finfo(float).tiny:
+                self._refuse_beyond_range_in_units(Wn, j, "underflows")
+
+    @staticmethod
+    def _column(W: Any, k: int) -> np.ndarray:
+        """Column ``k`` of a dense or sparse ``W`` as an array."""
+        return W[:, [k]].toarray().ravel() if is_sparse(W) else W[:, k]
+
+    def _refuse_beyond_range_in_units(self, Wn: Any, j: int, what: str) -> None:
+        """Refuse contact ``j``'s entry that ``what``, unless the solving mass unit reads it."""
+        column = self._column(Wn, j)
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            # A power of two: the product rounds nothing that does not leave the range.
+            entry = float(column.dot(self.solve(column * mass_unit(self.M))))
+        if not np.finfo(float).tiny <= entry < math.inf:
+            raise InvalidProblem(self._beyond_range("Wn", j, column, what))
+
+    def refuse_overflow(self, label: str, W: Any, diagonal: np.ndarray) -> None:
+        """Refuse a Jacobian ``W`` (the field ``label``) whose Delassus diagonal overflows.
+
+        ``diagonal`` holds the entries ``W[:, k].T M^-1 W[:, k]``; the first that is not finite
+        is named, with the scales of ``W`` and ``M^-1`` that made it.
+        """
+        if all_finite(diagonal):
+            return
+        k = int(np.flatnonzero(~np.isfinite(diagonal))[0])
+        raise InvalidProblem(self._beyond_range(label, k, self._column(W, k), "overflows"))
+
+    def _beyond_range(self, label: str, k: int, column: np.ndarray, what: str) -> str:
+        """Why entry ``k`` of the Delassus matrix of ``label`` cannot be read."""
+        return (
+            f"{label}[:, {k}]: the Delassus matrix {label}.T M^-1 {label} {what} at [{k}, {k}] "
+            f"(largest |{label}[:, {k}]| {np.abs(column).max():.3g}, largest entry of M^-1 on "
+            f"it {self.inverse_mass_on(column):.3g}): the effective mass is beyond double "
+            "precision"
+        )
 
 
 # A problem whose heaviest mass entry and fastest velocity component lie within this factor of
@@ -457,13 +490,24 @@ UNIT_BAND = 2.0**30
 
 
 def binary_scale(size: float) -> float:
-    """The power of two nearest ``size`` (1 for zero or a non-finite size).
+    """The power of two nearest ``size`` (1 for zero or a non-finite size), at most 2^1023.
 
     Multiplying by it is exact (no digit is rounded) wherever no number under- or overflows.
+    Sizes beyond 2^1023.5 (1.7e308) round to 2^1024, which no double holds: they take 2^1023.
     """
     if not math.isfinite(size) or size <= 0.0:
         return 1.0
-    return math.ldexp(1.0, round(math.log2(size)))
+    return math.ldexp(1.0, min(round(math.log2(size)), sys.float_info.max_exp - 1))
+
+
+def unit_near(size: float) -> float:
+    """1 for a ``size`` within `UNIT_BAND` of 1, else the power of two nearest it."""
+    return 1.0 if 1.0 / UNIT_BAND <= size <= UNIT_BAND else binary_scale(size)
+
+
+def mass_unit(M: Any) -> float:
+    """The unit of mass a scale-free law solves in: near the heaviest diagonal entry of M."""
+    return unit_near(float(M.diagonal().max()))
 
 
 def solving_units(M: Any, v: np.ndarray, contacts: Iterable[Any]) -> tuple[float, float, float]:
@@ -486,10 +530,7 @@ def solving_units(M: Any, v: np.ndarray, contacts: Iterable[Any]) -> tuple[float
     # A positive definite M's diagonal entries are positive.
     mass = float(M.diagonal().max())
     speed = float(np.abs(v).max())
-    mass_unit, velocity_unit = (
-        1.0 if 1.0 / UNIT_BAND <= size <= UNIT_BAND else binary_scale(size)
-        for size in (mass, speed)
-    )
+    mass_unit, velocity_unit = (unit_near(size) for size in (mass, speed))
     energy = mass_unit * velocity_unit * velocity_unit
     if not (mass_unit * velocity_unit > 0.0 and 0.0 < energy < math.inf):
         raise InvalidProblem(

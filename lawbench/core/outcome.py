@@ -171,15 +171,17 @@ def scaled_back(
         **outcome.diagnostics,
         "units": {"mass": mass, "velocity": velocity, "time": time},
     }
-    return Outcome.from_velocity(
-        problem,
-        outcome.v_plus * velocity,
-        outcome.Pn * (mass * velocity),
-        outcome.Pt * (mass * velocity),
-        status=outcome.status,
-        diagnostics=diagnostics,
-        path=outcome.path,
-    )
+    # A number that overflows here is refused by name by the caller.
+    with np.errstate(over="ignore", invalid="ignore"):
+        return Outcome.from_velocity(
+            problem,
+            outcome.v_plus * velocity,
+            outcome.Pn * (mass * velocity),
+            outcome.Pt * (mass * velocity),
+            status=outcome.status,
+            diagnostics=diagnostics,
+            path=outcome.path,
+        )
 
 
 def embedded(outcome: Outcome, closed: np.ndarray, problem: ImpactProblem) -> Outcome:

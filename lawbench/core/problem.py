@@ -25,11 +25,11 @@ from lawbench.core.geometry import Geometry
 from lawbench.core.metric import (
     SMALL,
     KineticMetric,
+    all_finite,
     cached,
     checked_gaps,
     checked_matrix,
     checked_range,
-    checked_sparse_matrix,
     closed_gaps,
     in_units,
     is_diagonal,
@@ -38,6 +38,7 @@ from lawbench.core.metric import (
     read_only_finite,
     solving_units,
 )
+from lawbench.core.sparse import checked_sparse_matrix
 
 # The kinds of restitution coefficient and the contact field that overrides ``e`` for each:
 # Newton's kinematic, Poisson's kinetic, Stronge's energetic coefficient.
@@ -337,14 +338,16 @@ class ImpactProblem:
             raise InvalidProblem(f"geometry is {type(geometry).__name__}, not Geometry")
         state["geometry"] = geometry
         state["metric"] = KineticMetric(self.M)
-        # Where M^-1 or v is extreme, the Delassus matrix and the energy overflow: both are
-        # refused below by name, not with a warning.
+        # Where M^-1 or v is extreme, the Delassus matrix, the energy and the gap rates
+        # overflow: each is refused by name, not with a warning.
         with np.errstate(over="ignore", invalid="ignore"):
             self._check_normals()
             momentum = self.M.dot(self.v)
             T_minus = float(self.v.dot(momentum)) / 2.0
-        if not math.isfinite(T_minus):
-            raise InvalidProblem(f"v and M give a kinetic energy that overflows ({T_minus})")
+            rates = {"M v": momentum, "v M v / 2": T_minus, "Wn.T v": self.un, "Wt.T v": self.ut}
+        for name, value in rates.items():
+            if not all_finite(np.asarray(value)):
+                raise InvalidProblem(f"{name} is beyond double precision (it overflows)")
         momentum.setflags(write=False)
         state.update(momentum=momentum, T_minus=T_minus)
 
@@ -503,11 +506,9 @@ class ImpactProblem:
 
         Blocks: ``[[Gnn, Gnt], [Gtn, Gtt]]`` with the m normal rows first, then the m*d
         tangential rows (contact j's tangential rows are ``m + j*d ... m + j*d + d - 1``).
-        Sparse for a sparse problem.
+        Sparse for a sparse problem; an entry of ``Wt`` that overflows is refused by name.
         """
-        if self.sparse:
-            return self.metric.sparse_delassus(self.W)
-        return self.metric.symmetric_product(self.W)
+        return self.metric.contact_delassus(self.W, self.Wt, self.m)
 
     @cached
     def ut(self) -> np.ndarray:

@@ -13,6 +13,9 @@ The format (version 1) holds one `ImpactProblem`:
 | ``gaps`` | (m,) initial gaps |
 | ``bodies`` | body name -> indices of its coordinates |
 | ``contacts`` | one entry per contact: every field of `lawbench.Contact` (null where unset) |
+| ``sparse`` | optional, true or false: whether the matrices are read back as scipy.sparse |
+
+Any other key (array, in NPZ and HDF5) is refused, naming it.
 
 Sign conventions as everywhere in lawbench: ``un < 0`` approaches, ``Pn >= 0`` pushes apart,
 ``v_plus = v + M^-1 (Wn Pn + Wt Pt)``.
@@ -22,9 +25,9 @@ written with Python's shortest round-trip repr, so every float is read back bit 
 ``.npz`` and ``.h5``/``.hdf5`` hold arrays; a matrix whose entries are mostly zero (sparse
 chains) is stored as CSR triplets (``<name>.data``, ``.indices``, ``.indptr``, ``.shape``), so a
 large sparse problem stays small on disk. A problem built with scipy.sparse matrices is marked
-``sparse`` (true) and read back with them; JSON writes its matrices dense. ``bodies`` and
-``contacts`` are stored as JSON text in the array files. HDF5 needs h5py
-(``pip install 'lawbench[hdf5]'``).
+``sparse`` (true) and read back with them; JSON writes its matrices dense, and reads them back
+sparse where a file is marked so by hand. ``bodies`` and ``contacts`` are stored as JSON text in
+the array files. HDF5 needs h5py (``pip install 'lawbench[hdf5]'``).
 """
 
 from __future__ import annotations
@@ -59,6 +62,11 @@ SPARSE_SHARE = 0.25
 # those of a file of MAX_BYTES in doubles.
 DENSE_MAX = MAX_BYTES // 8
 CONTACT_FIELDS = tuple(Contact.__dataclass_fields__)
+# Every key a file in the format may hold; ``sparse`` (true or false) marks a problem read back
+# with scipy.sparse matrices.
+KEYS = ("format", "version", *MATRICES, "bodies", "contacts", "sparse")
+# The arrays of a CSR triplet an NPZ or HDF5 file stores a mostly-zero matrix as.
+CSR_PARTS = ("data", "indices", "indptr", "shape")
 
 
 def to_dict(problem: ImpactProblem) -> dict[str, Any]:
@@ -79,11 +87,14 @@ def from_dict(data: Mapping[str, Any], where: str = "problem") -> ImpactProblem:
     Raises
     ------
     InvalidProblem
-        Naming ``where`` and the field.
+        Naming ``where`` and the field, or a key the format does not have.
     """
+    unknown = sorted(set(data) - set(KEYS), key=str)
+    if unknown:
+        raise InvalidProblem(f"{where}: unknown key {unknown[0]!r}; known: {', '.join(KEYS)}")
     if data.get("format") != FORMAT:
         raise InvalidProblem(f"{where}: format is {data.get('format')!r}, expected {FORMAT!r}")
-    if data.get("version") != VERSION:
+    if data.get("version") != VERSION or isinstance(data.get("version"), bool):
         raise InvalidProblem(f"{where}: version {data.get('version')!r} is not supported (1)")
     for name in ("M", "Wn", "v", "contacts"):
         if name not in data:
@@ -115,18 +126,31 @@ def from_dict(data: Mapping[str, Any], where: str = "problem") -> ImpactProblem:
     bodies = data.get("bodies", {})
     if not isinstance(bodies, Mapping):
         raise InvalidProblem(f"{where}: bodies must map names to index lists")
+    matrices = {name: data.get(name) for name in ("M", "Wn", "Wt")}
+    if _flag(data.get("sparse", False), where):
+        matrices = {name: _compressed(value) for name, value in matrices.items()}
     try:
         return ImpactProblem(
-            M=data["M"],
-            Wn=data["Wn"],
-            v=data["v"],
-            contacts=parsed,
-            Wt=data.get("Wt"),
-            bodies=bodies,
-            gaps=data.get("gaps"),
+            v=data["v"], contacts=parsed, bodies=bodies, gaps=data.get("gaps"), **matrices
         )
     except InvalidProblem as exc:
         raise InvalidProblem(f"{where}: {exc}") from None
+
+
+def _compressed(value: Any) -> Any:
+    """A matrix of a file marked sparse as CSR; a value of another shape as it is (refused)."""
+    if value is None or is_sparse(value) or np.ndim(value) != 2:
+        return value
+    return scipy.sparse.csr_array(np.asarray(value, dtype=float))
+
+
+def _flag(value: Any, where: str | Path) -> bool:
+    """The ``sparse`` mark: true or false (a boolean array of no dimension in NPZ and HDF5)."""
+    if isinstance(value, np.ndarray) and value.shape == () and value.dtype.kind == "b":
+        value = bool(value)
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidProblem(f"{where}: field 'sparse' = {value!r}: must be true or false")
+    return bool(value)
 
 
 def save_problem(problem: ImpactProblem, path: str | Path) -> Path:
@@ -303,6 +327,10 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> _Re
     """Plain data from the flat arrays of the NPZ or HDF5 file ``where``."""
     data: dict[str, Any] = {}
     storage: list[tuple[str, str]] = []
+    stored = set(KEYS) | {f"{name}.{part}" for name in MATRICES for part in CSR_PARTS}
+    unknown = sorted(names - stored)
+    if unknown:
+        raise InvalidProblem(f"{where}: unknown array {unknown[0]!r}; known: {', '.join(KEYS)}")
     for key in ("format", "version"):
         if key in names:
             value = np.asarray(get(key)).item()
@@ -311,13 +339,13 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> _Re
         if key in names:
             text = np.asarray(get(key)).item()
             data[key] = json.loads(text.decode() if isinstance(text, bytes) else text)
-    sparse = "sparse" in names and bool(np.asarray(get("sparse")))
+    sparse = "sparse" in names and _flag(np.asarray(get("sparse")), where)
     for name in MATRICES:
         if name in names:
             data[name] = np.asarray(get(name))
             storage.append((name, "dense"))
         elif f"{name}.data" in names:
-            shape = tuple(int(s) for s in np.asarray(get(f"{name}.shape")))
+            shape = _shape(np.asarray(get(f"{name}.shape")), name, where)
             matrix = scipy.sparse.csr_matrix(
                 (get(f"{name}.data"), get(f"{name}.indices"), get(f"{name}.indptr")), shape
             )
@@ -332,6 +360,16 @@ def _from_arrays(get: Callable[[str], Any], names: set[str], where: Path) -> _Re
             data[name] = matrix if sparse else _dense(matrix, name, where)
             storage.append((name, "compressed rows"))
     return _Read(data, tuple(storage), where)
+
+
+def _shape(value: np.ndarray, name: str, where: Path) -> tuple[int, int]:
+    """The shape a CSR triplet claims: two non-negative integers (of any integer dtype)."""
+    if value.shape != (2,) or value.dtype.kind not in "iu" or (value < 0).any():
+        raise InvalidProblem(
+            f"{where}: field {name!r}: its shape {value.tolist()!r} is not two non-negative "
+            "integers"
+        )
+    return int(value[0]), int(value[1])
 
 
 def _dense(matrix: scipy.sparse.csr_matrix, name: str, where: Path) -> np.ndarray:

@@ -342,14 +342,14 @@ def run_many(
             locks.enter_context(store.locked(wait))
             store.claim(grid, described)
         tasks, owner = _pending(plans, stores, resume)
-        total = sum(len(plan.jobs) for plan, _ in plans)
+        total = sum(_cells(plan) for plan, _ in plans)
         with _progress(total, total - len(tasks), quiet) as progress:
             _write(executor.run(tasks), owner, stores, chunk_size, progress)
         computed = [owner.count(number) for number in range(len(plans))]
         meta = metadata(seed)
         return [
             (
-                store.finish(len(plan.jobs), {**meta, "grid": grid, "grid_described": described}),
+                store.finish(_cells(plan), {**meta, "grid": grid, "grid_described": described}),
                 count,
             )
             for store, (plan, _), count, (grid, described) in zip(
@@ -376,9 +376,15 @@ def _pending(
         done = set(finished["key"]) if len(finished) else set()
         for index, job in enumerate(plan.jobs):
             if job.key not in done:
+                done.add(job.key)  # a cell the grid names twice is computed once
                 tasks.append(_task(plan, index, job))
                 owner.append(number)
     return tasks, owner
+
+
+def _cells(plan: Plan) -> int:
+    """The number of distinct cells of ``plan``: a grid may name one twice (e = [0, 0])."""
+    return len({job.key for job in plan.jobs})
 
 
 def _write(

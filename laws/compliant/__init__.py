@@ -152,11 +152,13 @@ class Compliant(Law):
 
     def _resolve(self, problem: ImpactProblem, options: dict[str, Any]) -> Outcome:
         G = problem.contact_delassus if problem.frictional else problem.delassus
-        if not all_finite(G.diagonal()):
+        diagonal = G.diagonal()
+        if not (all_finite(diagonal) and diagonal.min() > 0.0):
             raise NotApplicable(
                 "compliant: integrates in the problem's own units (a damping's unit depends on "
-                "the model), and this problem's inverse effective masses overflow (largest "
-                "Delassus entry beyond 1.8e308): give it in units near its masses"
+                "the model), and this problem's inverse effective masses overflow or underflow "
+                "(Delassus entries beyond 1.8e308 or below 2.2e-308): give it in units near "
+                "its masses"
             )
         integration = FrictionalIntegration if problem.frictional else Integration
         return integration(problem, options).run()

@@ -78,7 +78,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from lawbench.core.errors import NotApplicable
 from lawbench.core.guards import current_budget
+from lawbench.core.metric import all_finite
 from lawbench.core.outcome import Outcome
 from lawbench.core.problem import ImpactProblem
 from lawbench.laws.compliant.normal import Integration
@@ -120,7 +122,15 @@ class FrictionalIntegration(Integration):
         self.slips = 0
         # Newtons per scaled stretch, and scaled cone radius per newton of normal force.
         self.kt_scaled = self.kt * self.L
-        self.cone = self.mu / self.kt_scaled
+        with np.errstate(over="ignore", divide="ignore"):
+            self.cone = self.mu / self.kt_scaled
+        if not (all_finite(self.cone) and all_finite(self.kt_scaled)):
+            j = int(np.flatnonzero(~np.isfinite(self.cone * self.kt_scaled))[0])
+            raise NotApplicable(
+                f"compliant: contact {j}'s tangential spring, n k d^(n - 1) / ratio = "
+                f"{self.kt[j]:.3g} at exponent n = {self.n[j]:.3g}, leaves double precision "
+                f"against its Coulomb bound mu = {self.mu[j]:.3g}"
+            )
         # Each tangential spring's angular frequency in scaled time, on the contact's stiffest
         # tangential direction (its largest diagonal entry of the Delassus matrix).
         tangential = np.diagonal(self.Gc)[problem.m :].reshape(problem.m, self.d)

@@ -99,17 +99,19 @@ class Integration:
         G = scipy.sparse.csc_array(problem.delassus)
         diagonal = G.diagonal()
         self.V = float(max(np.abs(problem.un).max(), 1e-300))
-        # Each contact's indentation scale: where its spring holds the kinetic energy of its
-        # effective mass 1 / G_jj at the largest approach speed.
-        self.indentation = ((self.n + 1) * self.V**2 / (2 * self.k * diagonal)) ** (
-            1 / (self.n + 1)
-        )
-        self.L = float(self.indentation.min())
-        self.tau = self.L / self.V
-        self.G_max = float(diagonal.max())
-        self.I = self.V / self.G_max
-        # A force in newtons as a scaled impulse rate (time over tau, impulses over I).
-        self.scale = self.tau / self.I
+        with np.errstate(over="ignore", under="ignore", divide="ignore"):
+            # Each contact's indentation scale: where its spring holds the kinetic energy of
+            # its effective mass 1 / G_jj at the largest approach speed.
+            self.indentation = ((self.n + 1) * np.square(self.V) / (2 * self.k * diagonal)) ** (
+                1 / (self.n + 1)
+            )
+            self.L = float(self.indentation.min())
+            self.tau = self.L / self.V
+            self.G_max = float(diagonal.max())
+            self.I = self.V / self.G_max
+            # A force in newtons as a scaled impulse rate (time over tau, impulses over I).
+            self.scale = self.tau / self.I
+        self._refuse_scales_beyond_range()
         # Scaled Delassus matrix: the scaled gap-rate change per scaled impulse.
         self.G = G / self.G_max
         self.clipped = not (self.model == "kelvin_voigt" and options["termination"] == "gap")
@@ -121,6 +123,29 @@ class Integration:
         self.rest = options["tol"]
         stored = (self.rest * self.V) ** 2 / (2.0 * diagonal)
         self.band = (stored * (self.n + 1) / self.k) ** (1 / (self.n + 1)) / self.L
+
+    def _refuse_scales_beyond_range(self) -> None:
+        """Refuse an impact whose length, time, impulse or gap scale leaves double precision.
+
+        The integration runs in the problem's own units, scaled by these: an approach of 1e160
+        m/s on a Delassus entry of 1e20 has an indentation scale the square of the speed
+        overflows.
+        """
+        scales = {"indentation": self.L, "time": self.tau, "impulse": self.I, "force": self.scale}
+        for name, value in scales.items():
+            if not 0.0 < value < math.inf:
+                raise NotApplicable(
+                    f"compliant: integrates in the problem's own units, where this impact's "
+                    f"{name} scale leaves double precision (approach speed "
+                    f"{self.V:.3g}, largest Delassus entry {self.G_max:.3g}): give it in units "
+                    "near its masses and speeds"
+                )
+        gap = float(self.problem.gaps.max())
+        if not gap / self.L < math.inf:
+            raise NotApplicable(
+                f"compliant: a gap of {gap:.3g} m over the indentation scale ({self.L:.3g} m) "
+                "leaves double precision, and the integration reads gaps in that scale"
+            )
 
     def _initial_damping(self, G: np.ndarray) -> np.ndarray:
         c = self.given_damping.copy()

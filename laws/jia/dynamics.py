@@ -179,6 +179,12 @@ class SpringImpact:
             self._start_friction(j, u_minus)
         diag = np.diag(G)[: self.m] * self.kappa
         frequency = math.sqrt(float(diag.min()) / 2.0)
+        if not frequency > 0.0:
+            # A stiffness ratio of 5e-324 on a unit Delassus entry: a period beyond any double.
+            raise NotApplicable(
+                f"jia: the softest spring (stiffness ratio {self.kappa.min():.3g}) has a period "
+                "beyond double precision"
+            )
         self.time_scale = 2.0 * math.pi / frequency
         # The impulse that stops the fastest normal approach at the contact of the lightest
         # effective mass (largest G_jj): the smallest impulse scale of the problem, so that the
