@@ -377,6 +377,11 @@ def refuse_non_finite(name: str, **fields: Any) -> None:
             raise SolverFailure(f"{name}: non-finite {field} {value}")
 
 
+def _finite(value: Any) -> bool:
+    """Whether a float or an array holds only finite numbers."""
+    return math.isfinite(value) if isinstance(value, float) else not value.size or all_finite(value)
+
+
 class Budget:
     """Steps, events and seconds one solve of law ``law`` may spend.
 
@@ -511,8 +516,3 @@ class Watch:
         if self.caught:
             heard = {f"{w.category.__name__}: {w.message}" for w in self.caught}
             self.record["warnings"] = sorted(heard)
-
-
-def _finite(value: Any) -> bool:
-    """Whether a float or an array holds only finite numbers."""
-    return math.isfinite(value) if isinstance(value, float) else not value.size or all_finite(value)
