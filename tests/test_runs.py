@@ -2,6 +2,7 @@
 
 import functools
 import math
+import os
 import time
 
 import numpy as np
@@ -204,6 +205,19 @@ def test_the_guard_returns_answers_and_errors_and_stops_a_task_over_its_budget()
         error = guard.result(failing)
         assert (error.status, error.error_class) == ("error", "ValueError")
         assert guard.result(fine).value == 2.0
+
+
+def test_a_task_that_ends_its_worker_is_an_error_naming_the_exit_code():
+    """A law that calls os._exit ends only its worker; the guard says how it ended."""
+    with Guard(workers=1, budget_s=30.0) as guard:
+        ended = guard.result(guard.submit(os._exit, 3))
+        fine = guard.result(guard.submit(math.sqrt, 4.0))
+    assert (ended.status, ended.error_class, ended.error_message) == (
+        "error",
+        "WorkerDied",
+        "exit code 3",
+    )
+    assert fine.value == 2.0
 
 
 def _loaded_slowly(seconds: float) -> float:

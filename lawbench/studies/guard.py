@@ -40,6 +40,8 @@ WARNINGS_KEPT = 10
 # arguments need) before the task's own budget starts: a task is timed from when it begins, so
 # that a loaded machine's slow imports stop no task, and a worker stuck importing still ends.
 STARTUP_S = 120.0
+# Seconds a worker whose end of the pipe closed is given to end, so that its exit code is read.
+REAP_S = 1.0
 # What a worker sends when it begins a task, before its result.
 _BEGUN = "begun"
 # Seconds a cell may run before the guard stops it, unless told otherwise.
@@ -101,7 +103,7 @@ def _serve(connection: Connection) -> None:
     while True:
         try:
             message = connection.recv()
-        except EOFError:
+        except (EOFError, OSError):  # the parent is gone, or a law forked and its copy reads
             return
         if message is None:
             return
@@ -266,6 +268,7 @@ class Guard:
         try:
             reply = worker.connection.recv()
         except (EOFError, OSError):
+            worker.process.join(REAP_S)
             code = worker.process.exitcode
             self._replace(worker, Result("error", None, "WorkerDied", f"exit code {code}"))
             return
