@@ -346,16 +346,20 @@ def _study_law_by_name(job: tuple[str, str, bool]) -> list[tuple[dict[str, Any],
 def ranked(table: pd.DataFrame, judged: pd.DataFrame) -> tuple[pd.DataFrame, int]:
     """The table with ``common_error``, ranked by it, and the number of impacts it is taken on.
 
-    Rows judged on different impacts (a subsample, refusals) are ranked on the impacts that
-    every row with an answer solved: ``common_error`` is the median error there; ties and
-    rows without it follow ``median_error``.
+    Rows that refused or failed some impacts are ranked on the impacts that every row judged
+    on all the test impacts solved: ``common_error`` is the median error there. A row judged
+    on a subsample of them (a law that integrates in time, in the quick study) has none, and
+    follows by ``median_error`` with the rows without it: its few impacts would otherwise
+    decide every row's rank, and whether it ran at all (within its seconds) the order.
     """
-    solved = judged[judged["status"] == "ok"] if len(judged) else judged
-    per_row = [set(group) for _, group in solved.groupby(["law", "coefficients"])["index"]]
+    rows, solved = ["law", "coefficients"], judged
+    if len(judged):
+        tried = judged.groupby(rows)["index"].nunique()
+        whole = judged.set_index(rows).index.isin(tried.index[tried == tried.max()])
+        solved = judged[(judged["status"] == "ok").to_numpy() & whole]
+    per_row = [set(group) for _, group in solved.groupby(rows)["index"]]
     common = set.intersection(*per_row) if per_row else set()
-    medians = (
-        solved[solved["index"].isin(common)].groupby(["law", "coefficients"])["error"].median()
-    )
+    medians = solved[solved["index"].isin(common)].groupby(rows)["error"].median()
     keys = zip(table["law"], table["coefficients"], strict=True)
     table["common_error"] = [medians.get(key, math.nan) for key in keys]
     table = table.sort_values(["common_error", "median_error"], na_position="last", kind="stable")
