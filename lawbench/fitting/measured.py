@@ -23,8 +23,9 @@ against microseconds for a closed form) is fitted on a fixed,
 evenly spaced subsample of `COSTLY_FIT` training impacts and judged on every test impact
 (`COSTLY_JUDGE`); the columns ``fitted_on`` and ``judged_on`` say so. The quick mode keeps `QUICK`
 impacts of each half, evenly spaced, and `QUICK_COSTLY_FIT` and `QUICK_COSTLY_JUDGE` of them for
-a law that integrates in time. Rows judged on different impacts are ranked on the impacts every
-row solved (`ranked`). ``workers`` processes study the laws side by side.
+a law that integrates in time. Rows that refused or failed some impacts are ranked on the
+impacts every row judged on all of them solved; a row judged on a subsample follows
+(`ranked`). ``workers`` processes study the laws side by side.
 """
 
 from __future__ import annotations

@@ -259,7 +259,8 @@ def ranking(study: MeasuredStudy) -> Table:
     caption = (
         f"Set `{study.set_name}`: every law and baseline, fitted on the training impacts and "
         "ranked by the median of its relative kinetic error on the test impacts every row "
-        f"solved (column 'on the {study.common_count} common'), with the median on its own "
+        f"judged on all of them solved (column 'on the {study.common_count} common'; a row "
+        "judged on a subsample follows, by its own median), with the median on its own "
         "judged impacts (its mark: holds, refused, numerical failure or budget; the reason on "
         "hover), the bootstrap 95% interval of that median, the medians of the normal and "
         "tangential parts, the coefficients (fitted ± standard error, or a published set), "
