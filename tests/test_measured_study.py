@@ -176,29 +176,37 @@ def test_without_a_study_option_the_command_describes_the_set(capsys):
 
 
 def test_rows_judged_on_different_impacts_are_ranked_on_those_all_solved():
-    """A law that refused or failed some impacts is ranked with the others on the impacts
-    every row solved; its median on all it judged stays beside."""
+    """A law that refused or failed some impacts, while judging (b) or before (d, offered
+    only those it treats), is ranked with the others on the impacts every row solved; its
+    median on all it judged stays beside."""
     table = pd.DataFrame(
-        {"law": ["a", "b", "c"], "coefficients": "fitted", "median_error": [0.1, 0.2, np.nan]}
+        {
+            "law": ["a", "b", "c", "d"],
+            "coefficients": "fitted",
+            "median_error": [0.1, 0.2, np.nan, 0.25],
+            "refused": [0, 2, 4, 2],
+        }
     )
     judged = pd.DataFrame(
         {
-            "law": ["a"] * 4 + ["b"] * 4,
+            "law": ["a"] * 4 + ["b"] * 4 + ["d"] * 2,
             "coefficients": "fitted",
-            "index": [0, 1, 2, 3] * 2,
-            "status": ["ok", "ok", "ok", "failed", "refused", "ok", "ok", "refused"],
-            "error": [0.1, 0.3, 0.3, np.nan, np.nan, 0.1, 0.2, np.nan],
+            "index": [0, 1, 2, 3] * 2 + [1, 2],
+            "status": ["ok", "ok", "ok", "failed", "refused", "ok", "ok", "refused", "ok", "ok"],
+            "error": [0.1, 0.3, 0.3, np.nan, np.nan, 0.1, 0.2, np.nan, 0.2, 0.3],
         }
     )
     ordered, common = ranked(table, judged)
-    assert common == 2 and ordered["law"].tolist() == ["b", "a", "c"]
-    assert ordered["common_error"].tolist()[:2] == [pytest.approx(0.15), pytest.approx(0.3)]
+    assert common == 2 and ordered["law"].tolist() == ["b", "d", "a", "c"]
+    assert ordered["common_error"].tolist()[:3] == pytest.approx([0.15, 0.25, 0.3])
 
 
 def test_a_row_judged_on_a_subsample_follows_the_rows_judged_on_every_impact():
     """Two impacts of four, all it was given, decide no rank: the row judged on them follows
     the rows judged on all four, whatever its error there."""
-    table = pd.DataFrame({"law": ["a", "b"], "coefficients": "fitted", "median_error": [0.3, 0.1]})
+    table = pd.DataFrame(
+        {"law": ["a", "b"], "coefficients": "fitted", "median_error": [0.3, 0.1], "refused": 0}
+    )
     judged = pd.DataFrame(
         {
             "law": ["a"] * 4 + ["b"] * 2,

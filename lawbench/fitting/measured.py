@@ -355,8 +355,9 @@ def ranked(table: pd.DataFrame, judged: pd.DataFrame) -> tuple[pd.DataFrame, int
     """
     rows, solved = ["law", "coefficients"], judged
     if len(judged):
-        tried = judged.groupby(rows)["index"].nunique()
-        whole = judged.set_index(rows).index.isin(tried.index[tried == tried.max()])
+        offered = _offered(table, judged)
+        keys = judged.set_index(rows).index
+        whole = keys.isin(offered.index[offered == offered.max()])
         solved = judged[(judged["status"] == "ok").to_numpy() & whole]
     per_row = [set(group) for _, group in solved.groupby(rows)["index"]]
     common = set.intersection(*per_row) if per_row else set()
@@ -365,6 +366,20 @@ def ranked(table: pd.DataFrame, judged: pd.DataFrame) -> tuple[pd.DataFrame, int
     table["common_error"] = [medians.get(key, math.nan) for key in keys]
     table = table.sort_values(["common_error", "median_error"], na_position="last", kind="stable")
     return table.reset_index(drop=True), len(common)
+
+
+def _offered(table: pd.DataFrame, judged: pd.DataFrame) -> pd.Series:
+    """Per row of ``table`` (law, coefficients), the test impacts it was offered.
+
+    Those it judged (answered, refused or failed while judging), and those it refused before
+    (``refused`` counts both kinds of refusal): all the test impacts but for a subsample.
+    """
+    rows = ["law", "coefficients"]
+    tried = judged.groupby(rows)["index"].nunique()
+    refused_judging = judged[judged["status"] == "refused"].groupby(rows)["index"].nunique()
+    refused = table.set_index(rows)["refused"].fillna(0).groupby(level=rows).max()
+    before = (refused - refused_judging.reindex(refused.index, fill_value=0)).clip(lower=0)
+    return tried.add(before.reindex(tried.index, fill_value=0), fill_value=0)
 
 
 @dataclass(frozen=True)
