@@ -347,17 +347,15 @@ def _study_law_by_name(job: tuple[str, str, bool]) -> list[tuple[dict[str, Any],
 def ranked(table: pd.DataFrame, judged: pd.DataFrame) -> tuple[pd.DataFrame, int]:
     """The table with ``common_error``, ranked by it, and the number of impacts it is taken on.
 
-    Rows that refused or failed some impacts are ranked on the impacts that every row judged
-    on all the test impacts solved: ``common_error`` is the median error there. A row judged
-    on a subsample of them (a law that integrates in time, in the quick study) has none, and
-    follows by ``median_error`` with the rows without it: its few impacts would otherwise
-    decide every row's rank, and whether it ran at all (within its seconds) the order.
+    Rows that refused or failed some impacts are ranked on the impacts that every row offered
+    all the test impacts solved (`_offered`): ``common_error`` is the median error there. A
+    row judged on a subsample (a law that integrates in time, quick) has none and follows by
+    ``median_error``: its few impacts would decide every rank, and its seconds the order.
     """
     rows, solved = ["law", "coefficients"], judged
     if len(judged):
         offered = _offered(table, judged)
-        keys = judged.set_index(rows).index
-        whole = keys.isin(offered.index[offered == offered.max()])
+        whole = judged.set_index(rows).index.isin(offered.index[offered == offered.max()])
         solved = judged[(judged["status"] == "ok").to_numpy() & whole]
     per_row = [set(group) for _, group in solved.groupby(rows)["index"]]
     common = set.intersection(*per_row) if per_row else set()
