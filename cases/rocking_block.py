@@ -157,7 +157,7 @@ class RockingBlock(Case):
         _specs.friction(0.5, "Coulomb friction coefficient of both corners"),
     )
     # A frictional impact of a box at two corners: the engines' cost per impact with friction.
-    bench_roles = ("engines",)
+    bench_roles = ("engine_cost",)
     requires = Tags(friction=True, several_contacts=True)
     ground_truth = GroundTruth(
         why="Housner's plastic impact is exact where its premises hold (e = 0, the landing "

@@ -72,7 +72,7 @@ class ThreeBallChain(TwoContactChain):
     pairs = ((0, 1), (1, 2))
     # The smallest multiple impact: its start-up is the cost of the smallest command, and the
     # engines' cost per impact of a multiple impact.
-    bench_roles = ("start_up", "engines")
+    bench_roles = ("start_up", "engine_cost")
     ground_truth = SPRINGS
     references = (
         Reference(

@@ -58,7 +58,7 @@ def test_the_bench_prints_each_engine_s_cost_per_impact_at_each_setting():
         pytest.skip("no engine installed")
     lines = engine_impacts(1)
     peer = subject(LAWS, "lcp")
-    scenes = subjects(CASES, "engines")
+    scenes = subjects(CASES, "engine_cost")
     assert {"three_ball_chain", "rocking_block"} <= set(scenes)
     for scene in scenes:
         start = lines.index(f"engines on {scene} (median cost per impact; timed solves each: 1):")

@@ -332,7 +332,7 @@ def engine_impacts(repeats: int) -> list[str]:
     """Each engine's median cost per impact, at each of its settings, on the engines' scenes.
 
     The engines are the registered laws whose ``engine`` is true, their settings the choices of
-    their option ``settings``; the scenes those of the role ``engines``, at their defaults. Each
+    their option ``settings``; the scenes those of the role ``engine_cost``, at their defaults. Each
     figure is the median of ``repeats`` solves after one untimed solve (an engine's first
     loads its package), against the ``lcp`` law's solve of the same problem (the rigid law the
     tuned engines aim at), timed in the same alternated rounds. A solve that fails prints its
@@ -343,7 +343,7 @@ def engine_impacts(repeats: int) -> list[str]:
         return ["engines: none installed"]
     peer = LAWS[subject(LAWS, "lcp")]
     lines = []
-    for scene in subjects(CASES, "engines"):
+    for scene in subjects(CASES, "engine_cost"):
         problem = CASES[scene].build()
         calls: dict[str, Callable[[], object]] = {peer.name: lambda p=problem: peer.resolve(p)}
         for law in engines:

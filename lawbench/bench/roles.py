@@ -20,7 +20,7 @@ ROLES = {
     # the scene of n balls in a row (its parameter ``n``), solved from its parameters;
     "long_chain": "the n-ball chain scene solved from its parameters",
     # the scenes every engine (a law whose ``engine`` is true) is timed on, at each setting.
-    "engines": "the scenes the engines' cost per impact is measured on",
+    "engine_cost": "the scenes the engines' cost per impact is measured on",
 }
 
 
